@@ -1,0 +1,242 @@
+//! Collision meshes: read the vertices of a Wavefront `.obj` and fit a tight oriented box.
+//!
+//! The box is what the costs of EDMP use for a robot body. The original takes the mesh's
+//! axis-aligned box in the link frame; we search over orientations for the smallest volume
+//! that still holds every vertex, which is never larger and often much smaller.
+
+use crate::math::{self, Mat3, Vec3};
+use std::path::Path;
+
+/// An oriented box in some frame: `point = center + rotation · (s ⊙ half_extents)`, `|s_i| ≤ 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrientedBox {
+    /// Centre of the box.
+    pub center: Vec3,
+    /// Columns are the box's axes.
+    pub rotation: Mat3,
+    /// Half of the full extent along each box axis.
+    pub half_extents: Vec3,
+}
+
+impl OrientedBox {
+    /// Volume of the box.
+    pub fn volume(&self) -> f64 {
+        8.0 * self.half_extents[0] * self.half_extents[1] * self.half_extents[2]
+    }
+}
+
+/// Reads the `v x y z` lines of an `.obj` file (other records are ignored).
+pub fn read_obj_vertices(path: &Path) -> Result<Vec<Vec3>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    parse_obj_vertices(&text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Parses the vertex records of `.obj` text.
+pub fn parse_obj_vertices(text: &str) -> Result<Vec<Vec3>, String> {
+    let mut vertices = Vec::new();
+    for (line_no, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("v") {
+            continue;
+        }
+        let mut v = [0.0f64; 3];
+        for slot in &mut v {
+            let word = words
+                .next()
+                .ok_or(format!("line {}: vertex with fewer than 3 coordinates", line_no + 1))?;
+            *slot = word.parse().map_err(|e| format!("line {}: {e}", line_no + 1))?;
+            if !slot.is_finite() {
+                return Err(format!("line {}: non-finite coordinate", line_no + 1));
+            }
+        }
+        vertices.push(v);
+    }
+    if vertices.len() < 4 {
+        return Err(format!(
+            "{} vertices; a collision mesh needs at least 4",
+            vertices.len()
+        ));
+    }
+    Ok(vertices)
+}
+
+/// The axis-aligned box of `points` (what the original EDMP uses).
+pub fn aabb(points: &[Vec3]) -> OrientedBox {
+    box_with_axes(points, &math::IDENTITY)
+}
+
+/// The smallest box with the given axes (columns of `rotation`) that holds every point.
+pub fn box_with_axes(points: &[Vec3], rotation: &Mat3) -> OrientedBox {
+    let rt = math::transpose(rotation);
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        let local = math::mul_vec(&rt, p);
+        for i in 0..3 {
+            lo[i] = lo[i].min(local[i]);
+            hi[i] = hi[i].max(local[i]);
+        }
+    }
+    let mid = [0, 1, 2].map(|i| 0.5 * (lo[i] + hi[i]));
+    OrientedBox {
+        center: math::mul_vec(rotation, &mid),
+        rotation: *rotation,
+        half_extents: [0, 1, 2].map(|i| 0.5 * (hi[i] - lo[i])),
+    }
+}
+
+/// A tight oriented box: a deterministic multi-start local search over orientations for the
+/// smallest volume. Starts: the link-frame axes, the principal axes of the vertices, and turns
+/// of the link frame about each axis in 10° steps. Never larger than [`aabb`].
+pub fn tight_box(points: &[Vec3]) -> OrientedBox {
+    let mut starts = vec![math::IDENTITY, principal_axes(points)];
+    for axis in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] {
+        for k in 1..9 {
+            starts.push(math::axis_angle(&axis, f64::from(k) * 10f64.to_radians()));
+        }
+    }
+    let mut best = aabb(points);
+    for start in starts {
+        let candidate = refine(points, start);
+        if candidate.volume() < best.volume() * (1.0 - 1e-12) {
+            best = candidate;
+        }
+    }
+    canonical(points, &best)
+}
+
+fn principal_axes(points: &[Vec3]) -> Mat3 {
+    let n = points.len() as f64;
+    let mean = [0, 1, 2].map(|i| points.iter().map(|p| p[i]).sum::<f64>() / n);
+    let mut cov = [[0.0; 3]; 3];
+    for p in points {
+        for i in 0..3 {
+            for j in 0..3 {
+                cov[i][j] += (p[i] - mean[i]) * (p[j] - mean[j]) / n;
+            }
+        }
+    }
+    let mut v = math::symmetric_eigenvectors(&cov);
+    if math::det(&v) < 0.0 {
+        for row in &mut v {
+            row[2] = -row[2];
+        }
+    }
+    v
+}
+
+/// Coordinate descent on small turns about the box's own axes, halving the step when stuck.
+fn refine(points: &[Vec3], start: Mat3) -> OrientedBox {
+    let mut best = box_with_axes(points, &start);
+    let mut step = 0.1f64;
+    while step > 1e-6 {
+        let mut improved = false;
+        for axis in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] {
+            for sign in [1.0, -1.0] {
+                let turn = math::axis_angle(&axis, sign * step);
+                let candidate = box_with_axes(points, &math::mul(&best.rotation, &turn));
+                if candidate.volume() < best.volume() * (1.0 - 1e-12) {
+                    best = candidate;
+                    improved = true;
+                }
+            }
+        }
+        if !improved {
+            step *= 0.5;
+        }
+    }
+    best
+}
+
+/// Re-expresses the same box with its axes permuted and flipped to lie closest to the
+/// frame's x, y, z (readable tables: a box that is an AABB gets the identity), right-handed.
+fn canonical(points: &[Vec3], b: &OrientedBox) -> OrientedBox {
+    let mut used = [false; 3];
+    let mut columns = [[0.0; 3]; 3];
+    for (frame_axis, column) in columns.iter_mut().enumerate() {
+        let mut pick = 0;
+        let mut pick_abs = -1.0;
+        for (c, &taken) in used.iter().enumerate() {
+            let v = b.rotation[frame_axis][c].abs();
+            if !taken && v > pick_abs {
+                pick = c;
+                pick_abs = v;
+            }
+        }
+        used[pick] = true;
+        let sign = b.rotation[frame_axis][pick].signum();
+        *column = [0, 1, 2].map(|r| sign * b.rotation[r][pick]);
+    }
+    let mut rotation = math::transpose(&columns);
+    if math::det(&rotation) < 0.0 {
+        for row in &mut rotation {
+            row[2] = -row[2];
+        }
+    }
+    box_with_axes(points, &orthonormalise(&rotation))
+}
+
+/// Gram-Schmidt on the columns, so accumulated turns stay a rotation to f64 precision.
+fn orthonormalise(m: &Mat3) -> Mat3 {
+    let col = |j: usize| [m[0][j], m[1][j], m[2][j]];
+    let unit = |v: Vec3| {
+        let n = math::norm(&v);
+        [v[0] / n, v[1] / n, v[2] / n]
+    };
+    let dot = |a: &Vec3, b: &Vec3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let x = unit(col(0));
+    let y0 = col(1);
+    let d = dot(&x, &y0);
+    let y = unit([y0[0] - d * x[0], y0[1] - d * x[1], y0[2] - d * x[2]]);
+    let z = [
+        x[1] * y[2] - x[2] * y[1],
+        x[2] * y[0] - x[0] * y[2],
+        x[0] * y[1] - x[1] * y[0],
+    ];
+    math::transpose(&[x, y, z])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube_corners(rotation: &Mat3, half: Vec3, center: Vec3) -> Vec<Vec3> {
+        let mut out = Vec::new();
+        for i in 0..8 {
+            let s = [0, 1, 2].map(|k| if i >> k & 1 == 1 { 1.0 } else { -1.0 });
+            let local = [0, 1, 2].map(|k| s[k] * half[k]);
+            out.push(math::add(&center, &math::mul_vec(rotation, &local)));
+        }
+        out
+    }
+
+    #[test]
+    fn recovers_a_rotated_box() {
+        let r = math::mul(
+            &math::axis_angle(&[0.0, 0.0, 1.0], 0.3),
+            &math::axis_angle(&[1.0, 0.0, 0.0], 0.2),
+        );
+        let pts = cube_corners(&r, [0.05, 0.1, 0.2], [0.1, -0.2, 0.3]);
+        let b = tight_box(&pts);
+        assert!((b.volume() - 8.0 * 0.05 * 0.1 * 0.2).abs() < 1e-6 * b.volume(), "{b:?}");
+        assert!(b.volume() < aabb(&pts).volume());
+    }
+
+    #[test]
+    fn aligned_box_stays_aligned() {
+        let pts = cube_corners(&math::IDENTITY, [0.05, 0.1, 0.2], [0.0, 0.0, 0.0]);
+        let b = tight_box(&pts);
+        for i in 0..3 {
+            assert!((b.rotation[i][i] - 1.0).abs() < 1e-9, "{b:?}");
+        }
+    }
+
+    #[test]
+    fn parses_vertices_and_rejects_junk() {
+        let v = parse_obj_vertices("# c\nv 0 0 0\nv 1 0 0\nvn 0 0 1\nv 0 1 0\nv 0 0 1\nf 1 2 3\n").unwrap();
+        assert_eq!(v.len(), 4);
+        assert!(parse_obj_vertices("v 0 0\n").is_err());
+        assert!(parse_obj_vertices("v 0 0 x\n").is_err());
+        assert!(parse_obj_vertices("v 0 0 0\n").is_err());
+    }
+}

@@ -1,0 +1,248 @@
+//! The kinematic chain read from the URDF: frames in parent-before-child order, the actuated
+//! joints with both limit sets, and one collision body per link that has a collision mesh.
+
+use crate::math::{self, Mat3, Vec3};
+use crate::mesh::{self, OrientedBox};
+use std::path::{Path, PathBuf};
+
+/// Opening of each Panda finger, held fixed: the MpiNets / robofin convention that
+/// `shared/spec/formats.md` makes part of the contract.
+pub const FINGER_OPENING: f64 = 0.025;
+/// The URDF link that is the tool centre point (`spec/formats.md`).
+pub const TCP_LINK: &str = "panda_grasptarget";
+/// The URDF link that a held object is attached to (`spec/formats.md`).
+pub const HAND_LINK: &str = "panda_hand";
+
+/// How a frame moves relative to its parent.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Motion {
+    /// Rigidly attached (fixed joints, and the fingers held at [`FINGER_OPENING`]).
+    Fixed,
+    /// Turns about `axis` (in its own frame) by the actuated joint `joint`.
+    Revolute {
+        /// Index among the actuated joints, in chain order.
+        joint: usize,
+        /// Unit axis in the child frame.
+        axis: Vec3,
+    },
+}
+
+/// One link frame of the chain.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// URDF link name.
+    pub name: String,
+    /// Index of the parent frame; the root is its own parent.
+    pub parent: usize,
+    /// Rotation of the joint origin relative to the parent frame.
+    pub origin_rotation: Mat3,
+    /// Translation of the joint origin relative to the parent frame (finger opening folded in).
+    pub origin_translation: Vec3,
+    /// How the frame moves.
+    pub motion: Motion,
+    /// Where the numbers come from, for the generated comment.
+    pub provenance: String,
+}
+
+/// Limits of one actuated joint.
+#[derive(Clone, Debug)]
+pub struct JointLimits {
+    /// URDF joint name.
+    pub name: String,
+    /// `<limit lower upper>`: the hardware range.
+    pub hard: [f64; 2],
+    /// `<safety_controller soft_lower_limit soft_upper_limit>`: Franka's official range, used for planning.
+    pub soft: [f64; 2],
+}
+
+/// A collision body: a mesh rigidly attached to a frame, and its boxes.
+#[derive(Clone, Debug)]
+pub struct Body {
+    /// URDF link name.
+    pub name: String,
+    /// Index of the frame the box is expressed in.
+    pub frame: usize,
+    /// Mesh file, relative to the URDF's folder.
+    pub mesh: String,
+    /// Number of mesh vertices the boxes were fitted to.
+    pub vertex_count: usize,
+    /// The tight oriented box in the link frame.
+    pub tight: OrientedBox,
+    /// The link-frame axis-aligned box (what the original EDMP uses), for comparison.
+    pub aabb: OrientedBox,
+}
+
+/// Everything the generator knows of the robot.
+#[derive(Clone, Debug)]
+pub struct Chain {
+    /// Frames, parents first.
+    pub frames: Vec<Frame>,
+    /// Actuated joints, in chain order.
+    pub joints: Vec<JointLimits>,
+    /// Collision bodies, in frame order.
+    pub bodies: Vec<Body>,
+    /// Index of the TCP frame.
+    pub tcp: usize,
+    /// Index of the hand frame.
+    pub hand: usize,
+    /// Every file that was read (for `cargo:rerun-if-changed`).
+    pub inputs: Vec<PathBuf>,
+}
+
+/// Reads the URDF at `path` and the collision meshes it names.
+pub fn read_chain(path: &Path) -> Result<Chain, String> {
+    let robot = urdf_rs::read_file(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let root_dir = path.parent().unwrap_or(Path::new("."));
+    let mut inputs = vec![path.to_path_buf()];
+
+    let is_child = |name: &str| robot.joints.iter().any(|j| j.child.link == name);
+    let roots: Vec<_> = robot.links.iter().filter(|l| !is_child(&l.name)).collect();
+    let [root] = roots.as_slice() else {
+        return Err(format!("expected one root link, found {}", roots.len()));
+    };
+
+    let mut frames = vec![Frame {
+        name: root.name.clone(),
+        parent: 0,
+        origin_rotation: math::IDENTITY,
+        origin_translation: [0.0; 3],
+        motion: Motion::Fixed,
+        provenance: format!("root link `{}`: the world frame", root.name),
+    }];
+    let mut joints = Vec::new();
+    // Breadth-first in declaration order, so every parent precedes its children.
+    let mut next = 0;
+    while next < frames.len() {
+        let parent_name = frames[next].name.clone();
+        for joint in robot.joints.iter().filter(|j| j.parent.link == parent_name) {
+            let origin_rotation = math::rpy_to_matrix(&joint.origin.rpy);
+            let mut origin_translation = *joint.origin.xyz;
+            let xyz = *joint.origin.xyz;
+            let rpy = *joint.origin.rpy;
+            let (motion, provenance) = match joint.joint_type {
+                urdf_rs::JointType::Revolute => {
+                    let axis = normalised(&joint.axis.xyz, &joint.name)?;
+                    let safety = joint
+                        .safety_controller
+                        .as_ref()
+                        .ok_or(format!("joint `{}` has no <safety_controller> soft limits", joint.name))?;
+                    joints.push(JointLimits {
+                        name: joint.name.clone(),
+                        hard: [joint.limit.lower, joint.limit.upper],
+                        soft: [safety.soft_lower_limit, safety.soft_upper_limit],
+                    });
+                    let motion = Motion::Revolute {
+                        joint: joints.len() - 1,
+                        axis,
+                    };
+                    (
+                        motion,
+                        format!(
+                            "revolute `{}`: origin xyz={xyz:?} rpy={rpy:?}, axis {axis:?}",
+                            joint.name
+                        ),
+                    )
+                }
+                urdf_rs::JointType::Fixed => (
+                    Motion::Fixed,
+                    format!("fixed `{}`: origin xyz={xyz:?} rpy={rpy:?}", joint.name),
+                ),
+                urdf_rs::JointType::Prismatic => {
+                    let axis = normalised(&joint.axis.xyz, &joint.name)?;
+                    // d = R_origin · axis · opening, folded into the origin.
+                    let shift = math::mul_vec(&origin_rotation, &axis);
+                    for (o, s) in origin_translation.iter_mut().zip(shift) {
+                        *o += s * FINGER_OPENING;
+                    }
+                    let provenance = format!(
+                        "prismatic `{}` held at {FINGER_OPENING} m along axis {axis:?}: origin xyz={xyz:?} rpy={rpy:?}",
+                        joint.name
+                    );
+                    (Motion::Fixed, provenance)
+                }
+                ref other => return Err(format!("joint `{}`: unsupported type {other:?}", joint.name)),
+            };
+            frames.push(Frame {
+                name: joint.child.link.clone(),
+                parent: next,
+                origin_rotation,
+                origin_translation,
+                motion,
+                provenance,
+            });
+        }
+        next += 1;
+    }
+    if frames.len() != robot.links.len() {
+        return Err(format!(
+            "{} links but {} reachable from the root",
+            robot.links.len(),
+            frames.len()
+        ));
+    }
+
+    let mut bodies = Vec::new();
+    for (index, frame) in frames.iter().enumerate() {
+        let link = robot
+            .links
+            .iter()
+            .find(|l| l.name == frame.name)
+            .ok_or("link vanished")?;
+        let mut points = Vec::new();
+        let mut meshes = Vec::new();
+        for collision in &link.collision {
+            let urdf_rs::Geometry::Mesh { filename, scale } = &collision.geometry else {
+                return Err(format!(
+                    "link `{}`: only mesh collision geometry is supported",
+                    link.name
+                ));
+            };
+            let relative = filename.strip_prefix("package://").unwrap_or(filename);
+            let file = root_dir.join(relative);
+            let scale = scale.map(|s| *s).unwrap_or([1.0; 3]);
+            let rotation = math::rpy_to_matrix(&collision.origin.rpy);
+            for v in mesh::read_obj_vertices(&file)? {
+                let scaled = [v[0] * scale[0], v[1] * scale[1], v[2] * scale[2]];
+                points.push(math::add(&math::mul_vec(&rotation, &scaled), &collision.origin.xyz));
+            }
+            meshes.push(relative.to_string());
+            inputs.push(file);
+        }
+        if points.is_empty() {
+            continue;
+        }
+        bodies.push(Body {
+            name: link.name.clone(),
+            frame: index,
+            mesh: meshes.join(" + "),
+            vertex_count: points.len(),
+            tight: mesh::tight_box(&points),
+            aabb: mesh::aabb(&points),
+        });
+    }
+
+    let find = |name: &str| {
+        frames
+            .iter()
+            .position(|f| f.name == name)
+            .ok_or(format!("no link `{name}`"))
+    };
+    let tcp = find(TCP_LINK)?;
+    let hand = find(HAND_LINK)?;
+    Ok(Chain {
+        frames,
+        joints,
+        bodies,
+        tcp,
+        hand,
+        inputs,
+    })
+}
+
+fn normalised(v: &Vec3, joint: &str) -> Result<Vec3, String> {
+    let n = math::norm(v);
+    if !(n > 0.0) || !n.is_finite() {
+        return Err(format!("joint `{joint}`: axis {v:?} is not a direction"));
+    }
+    Ok([v[0] / n, v[1] / n, v[2] / n])
+}

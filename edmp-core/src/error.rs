@@ -1,0 +1,30 @@
+//! The core's one error type: small, `Copy`, no strings.
+
+use core::fmt;
+
+/// Why a core computation refused its input or could not give a finite answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Error {
+    /// A joint value is NaN or infinite (`joint` is its index).
+    NonFiniteJoint {
+        /// Index of the offending joint.
+        joint: u8,
+    },
+    /// An upstream gradient holds a NaN or infinite value.
+    NonFiniteGradient,
+    /// The inputs were finite but the result overflowed (gradients near `f32::MAX`).
+    Overflow,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NonFiniteJoint { joint } => write!(f, "joint {joint} is not a finite number"),
+            Self::NonFiniteGradient => f.write_str("upstream gradient is not finite"),
+            Self::Overflow => f.write_str("result overflowed to a non-finite value"),
+        }
+    }
+}
+
+impl core::error::Error for Error {}

@@ -1,0 +1,266 @@
+//! Forward kinematics of the Panda, its hand-written adjoint, and frame Jacobians.
+//!
+//! [`forward`] maps 7 joint angles to the world pose of every link frame and of every
+//! collision box. [`Kinematics::adjoint`] takes an upstream gradient on box corners (and, if
+//! wanted, on frame poses) back to the joints in one leaf-to-root sweep:
+//!
+//! a turn `dq` of revolute joint `i` (world axis `a`, through world point `o`) moves every
+//! point `p` downstream by `dq·a×(p−o)` and turns every frame by `dq·[a]×R`. So with the
+//! "force" `F = Σ g` and "moment" `M = Σ p×g + Σ_j R_j×G_j` of the upstream gradients of the
+//! subtree (`R_j`, `G_j` columns of a rotation and of its gradient),
+//! `∂L/∂q_i = a · (M − o×F)`. Subtree sums are accumulated child to parent, so the sweep is
+//! O(frames + corners), with no matrix of partial derivatives ever formed.
+
+use crate::error::Error;
+use crate::robot::{BODIES, FRAMES, JOINTS, Real, TCP_FRAME};
+use nalgebra::{Matrix3, Vector3};
+
+/// A rigid transform: `world = rotation · local + translation`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose<T: Real> {
+    /// Orientation (columns are the frame's axes in world coordinates).
+    pub rotation: Matrix3<T>,
+    /// Origin in world coordinates.
+    pub translation: Vector3<T>,
+}
+
+impl<T: Real> Pose<T> {
+    /// The identity transform.
+    pub fn identity() -> Self {
+        Self {
+            rotation: Matrix3::identity(),
+            translation: Vector3::zeros(),
+        }
+    }
+
+    /// `self ∘ local`: a pose given in this frame, expressed in the world.
+    pub fn compose(&self, rotation: &Matrix3<T>, translation: &Vector3<T>) -> Self {
+        Self {
+            rotation: self.rotation * rotation,
+            translation: self.translation + self.rotation * translation,
+        }
+    }
+
+    /// A point given in this frame, expressed in the world.
+    pub fn transform_point(&self, p: &Vector3<T>) -> Vector3<T> {
+        self.rotation * p + self.translation
+    }
+}
+
+/// Joint angles of the 7 actuated joints, radians.
+pub type Joints<T> = [T; JOINTS];
+
+/// Corner `k` of a box has sign `+` on axis `i` where bit `i` of `k` is set.
+pub const CORNERS: usize = 8;
+
+/// Upstream gradient on the 8 world corners of every collision body.
+pub type CornerGradient<T> = [[Vector3<T>; CORNERS]; BODIES];
+
+/// World poses of every link frame and every collision box for one configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Kinematics<T: Real> {
+    /// World pose of each link frame (see `robot::FRAME_NAMES`).
+    pub frames: [Pose<T>; FRAMES],
+    /// World pose of each collision box (centre and axes; see `robot::BODY_NAMES`).
+    pub boxes: [Pose<T>; BODIES],
+}
+
+/// Forward kinematics: world pose of every frame and collision box.
+///
+/// Any finite angle is accepted (limits are the planner's business); NaN or infinity is
+/// refused with [`Error::NonFiniteJoint`], so every output is finite.
+pub fn forward<T: Real>(q: &Joints<T>) -> Result<Kinematics<T>, Error> {
+    for (i, &qi) in q.iter().enumerate() {
+        if !qi.finite() {
+            return Err(Error::NonFiniteJoint { joint: i as u8 });
+        }
+    }
+    let robot = T::robot();
+    let mut frames = [Pose::identity(); FRAMES];
+    for i in 1..FRAMES {
+        let spec = &robot.frames[i];
+        let rotation = match spec.joint.and_then(|j| q.get(j)) {
+            Some(&angle) => {
+                let (s, c) = angle.sin_cos_libm();
+                spec.rot_fixed + spec.rot_cos * c + spec.rot_sin * s
+            }
+            None => spec.rot_fixed,
+        };
+        let parent = frames[spec.parent.min(i - 1)];
+        frames[i] = parent.compose(&rotation, &spec.translation);
+    }
+    let mut boxes = [Pose::identity(); BODIES];
+    for (pose, body) in boxes.iter_mut().zip(robot.bodies.iter()) {
+        *pose = frames[body.frame.min(FRAMES - 1)].compose(&body.rotation, &body.center);
+    }
+    Ok(Kinematics { frames, boxes })
+}
+
+impl<T: Real> Kinematics<T> {
+    /// World pose of the tool centre point (`panda_grasptarget`).
+    pub fn tcp(&self) -> &Pose<T> {
+        &self.frames[TCP_FRAME]
+    }
+
+    /// The 8 world corners of collision body `body` (see [`CORNERS`] for the order).
+    pub fn corners(&self, body: usize) -> [Vector3<T>; CORNERS] {
+        let robot = T::robot();
+        let pose = &self.boxes[body % BODIES];
+        let h = robot.bodies[body % BODIES].half_extents;
+        let axes = [
+            pose.rotation.column(0) * h.x,
+            pose.rotation.column(1) * h.y,
+            pose.rotation.column(2) * h.z,
+        ];
+        core::array::from_fn(|k| {
+            let pick = |bit: usize, v: &Vector3<T>| if k >> bit & 1 == 1 { *v } else { -*v };
+            pose.translation + pick(0, &axes[0]) + pick(1, &axes[1]) + pick(2, &axes[2])
+        })
+    }
+
+    /// The corners of every collision body.
+    pub fn all_corners(&self) -> [[Vector3<T>; CORNERS]; BODIES] {
+        core::array::from_fn(|b| self.corners(b))
+    }
+
+    /// Reverse mode: the gradient with respect to the joints of a scalar whose gradient with
+    /// respect to every box corner is `corner_grad`.
+    pub fn adjoint(&self, corner_grad: &CornerGradient<T>) -> Result<Joints<T>, Error> {
+        self.adjoint_with_frames(corner_grad, &[])
+    }
+
+    /// Like [`Self::adjoint`], plus upstream gradients on frame poses:
+    /// `(frame, ∂L/∂translation, ∂L/∂rotation)` entries (repeats add up).
+    pub fn adjoint_with_frames(
+        &self,
+        corner_grad: &CornerGradient<T>,
+        frame_grad: &[(usize, Vector3<T>, Matrix3<T>)],
+    ) -> Result<Joints<T>, Error> {
+        let finite = |v: &[T]| v.iter().all(|x| x.finite());
+        let corners_ok = corner_grad.iter().flatten().all(|g| finite(g.as_slice()));
+        let frames_ok = frame_grad
+            .iter()
+            .all(|(f, gt, gr)| *f < FRAMES && finite(gt.as_slice()) && finite(gr.as_slice()));
+        if !corners_ok || !frames_ok {
+            return Err(Error::NonFiniteGradient);
+        }
+
+        let robot = T::robot();
+        // Per-frame force F and moment M (about the world origin) of the upstream gradient.
+        let mut force = [Vector3::<T>::zeros(); FRAMES];
+        let mut moment = [Vector3::<T>::zeros(); FRAMES];
+        for (b, grads) in corner_grad.iter().enumerate() {
+            let frame = robot.bodies[b].frame.min(FRAMES - 1);
+            let corners = self.corners(b);
+            for (c, g) in corners.iter().zip(grads.iter()) {
+                force[frame] += g;
+                moment[frame] += c.cross(g);
+            }
+        }
+        for (frame, gt, gr) in frame_grad {
+            let pose = &self.frames[*frame];
+            force[*frame] += gt;
+            moment[*frame] += pose.translation.cross(gt);
+            for j in 0..3 {
+                moment[*frame] += pose.rotation.column(j).cross(&gr.column(j));
+            }
+        }
+        // Leaf to root: fold each subtree into its parent, reading joints on the way.
+        let mut dq = [T::zero(); JOINTS];
+        for i in (1..FRAMES).rev() {
+            let spec = &robot.frames[i];
+            if let Some(slot) = spec.joint.and_then(|j| dq.get_mut(j)) {
+                let pose = &self.frames[i];
+                let axis = pose.rotation * spec.axis;
+                *slot = axis.dot(&(moment[i] - pose.translation.cross(&force[i])));
+            }
+            let parent = spec.parent.min(i - 1);
+            let (f, m) = (force[i], moment[i]);
+            force[parent] += f;
+            moment[parent] += m;
+        }
+        if dq.iter().all(|x| x.finite()) {
+            Ok(dq)
+        } else {
+            Err(Error::Overflow)
+        }
+    }
+
+    /// The 6×7 geometric Jacobian of frame `frame`: rows 0-2 the linear velocity of its origin,
+    /// rows 3-5 its angular velocity, per unit joint rate. Joints that do not move the frame
+    /// give zero columns; an out-of-range `frame` gives all zeros.
+    pub fn jacobian(&self, frame: usize) -> [[T; JOINTS]; 6] {
+        let robot = T::robot();
+        let mut jac = [[T::zero(); JOINTS]; 6];
+        if frame >= FRAMES {
+            return jac;
+        }
+        let target = self.frames[frame].translation;
+        for (i, spec) in robot.frames.iter().enumerate() {
+            let Some(j) = spec.joint.filter(|&j| j < JOINTS) else {
+                continue;
+            };
+            if !robot.is_ancestor(i, frame) {
+                continue;
+            }
+            let pose = &self.frames[i];
+            let axis = pose.rotation * spec.axis;
+            let linear = axis.cross(&(target - pose.translation));
+            for r in 0..3 {
+                jac[r][j] = linear[r];
+                jac[r + 3][j] = axis[r];
+            }
+        }
+        jac
+    }
+
+    /// The TCP Jacobian (see [`Self::jacobian`]); inverse kinematics uses it.
+    pub fn tcp_jacobian(&self) -> [[T; JOINTS]; 6] {
+        self.jacobian(TCP_FRAME)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const READY: [f32; 7] = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
+
+    #[test]
+    fn refuses_non_finite_joints() {
+        let mut q = READY;
+        q[3] = f32::NAN;
+        assert_eq!(forward(&q), Err(Error::NonFiniteJoint { joint: 3 }));
+        q[3] = f32::INFINITY;
+        assert_eq!(forward(&q), Err(Error::NonFiniteJoint { joint: 3 }));
+    }
+
+    #[test]
+    fn refuses_non_finite_gradients_and_reports_overflow() {
+        let k = forward(&READY).unwrap();
+        let mut g = [[Vector3::zeros(); CORNERS]; BODIES];
+        g[4][2].y = f32::NAN;
+        assert_eq!(k.adjoint(&g), Err(Error::NonFiniteGradient));
+        let g = [[Vector3::repeat(f32::MAX); CORNERS]; BODIES];
+        assert_eq!(k.adjoint(&g), Err(Error::Overflow));
+    }
+
+    #[test]
+    fn zero_configuration_tcp_is_straight_up_and_forward() {
+        // All-zero joints: the arm stands up with the flange offset along +x.
+        let k = forward(&[0.0f64; 7]).unwrap();
+        let p = k.tcp().translation;
+        assert!((p.x - 0.088).abs() < 1e-9, "{p}");
+        assert!(p.y.abs() < 1e-9, "{p}");
+        assert!((p.z - (0.333 + 0.316 + 0.384 - 0.107 - 0.105)).abs() < 1e-9, "{p}");
+    }
+
+    #[test]
+    fn rotations_stay_orthonormal() {
+        let k = forward(&READY).unwrap();
+        for pose in k.frames.iter().chain(k.boxes.iter()) {
+            let err = (pose.rotation.transpose() * pose.rotation - Matrix3::identity()).norm();
+            assert!(err < 1e-5, "{err}");
+        }
+    }
+}

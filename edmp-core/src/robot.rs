@@ -1,0 +1,155 @@
+//! The Panda as frozen by `edmp-codegen` at build time: link frames, collision boxes, limits.
+//!
+//! No number of the robot is typed here: the tables come from `OUT_DIR/panda.rs`, which the
+//! build script generates from `weights/panda/panda.urdf` and its collision meshes. Read the
+//! generated file (or run `cargo run -p edmp-codegen`) to see each number and its origin.
+
+use nalgebra::{Matrix3, RealField, Vector3};
+
+/// One link frame: where it sits on its parent and how its joint turns it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSpec<T> {
+    /// Index of the parent frame (the root, frame 0, names itself).
+    pub parent: usize,
+    /// The actuated joint that turns this frame, if any.
+    pub joint: Option<usize>,
+    /// Joint origin translation in the parent frame.
+    pub translation: Vector3<T>,
+    /// Unit joint axis in this frame (zero for fixed frames).
+    pub axis: Vector3<T>,
+    /// With `rot_cos` and `rot_sin`: the rotation relative to the parent is
+    /// `rot_fixed + cos(q)·rot_cos + sin(q)·rot_sin` (Rodrigues folded with the origin rotation).
+    pub rot_fixed: Matrix3<T>,
+    /// See `rot_fixed`.
+    pub rot_cos: Matrix3<T>,
+    /// See `rot_fixed`.
+    pub rot_sin: Matrix3<T>,
+}
+
+/// A collision body's oriented box in its link frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodySpec<T> {
+    /// Frame the box is attached to.
+    pub frame: usize,
+    /// Box centre in that frame.
+    pub center: Vector3<T>,
+    /// Box axes (columns) in that frame.
+    pub rotation: Matrix3<T>,
+    /// Half of the full extent along each box axis.
+    pub half_extents: Vector3<T>,
+}
+
+/// Every table of the robot in one scalar type.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Robot<T> {
+    /// Link frames, parents before children.
+    pub frames: [FrameSpec<T>; FRAMES],
+    /// Collision bodies.
+    pub bodies: [BodySpec<T>; BODIES],
+    /// Franka's official lower joint limits (URDF `safety_controller`), used for planning.
+    pub soft_lower: [T; JOINTS],
+    /// Franka's official upper joint limits.
+    pub soft_upper: [T; JOINTS],
+    /// URDF `<limit lower>`: the hardware range, wider than the soft one.
+    pub hard_lower: [T; JOINTS],
+    /// URDF `<limit upper>`.
+    pub hard_upper: [T; JOINTS],
+}
+
+include!(concat!(env!("OUT_DIR"), "/panda.rs"));
+
+/// The Panda in `f32`: what the planner uses.
+pub static PANDA: Robot<f32> = panda_tables!();
+/// The Panda in `f64`: for oracles (finite differences) and host-side tools.
+pub static PANDA_F64: Robot<f64> = panda_tables!();
+
+/// The scalar types the kinematics run in: `f32` (planner) and `f64` (oracles).
+///
+/// Every transcendental goes through the `libm` crate, so results are bit-identical on every
+/// target (x86_64, thumbv7em) whatever the platform's own math library does.
+pub trait Real: RealField + Copy {
+    /// The robot tables in this type.
+    fn robot() -> &'static Robot<Self>;
+    /// `(sin x, cos x)` through `libm`.
+    fn sin_cos_libm(self) -> (Self, Self);
+    /// Neither NaN nor infinite.
+    fn finite(self) -> bool;
+}
+
+impl Real for f32 {
+    fn robot() -> &'static Robot<Self> {
+        &PANDA
+    }
+    fn sin_cos_libm(self) -> (Self, Self) {
+        libm::sincosf(self)
+    }
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl Real for f64 {
+    fn robot() -> &'static Robot<Self> {
+        &PANDA_F64
+    }
+    fn sin_cos_libm(self) -> (Self, Self) {
+        libm::sincos(self)
+    }
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl<T: Real> Robot<T> {
+    /// Whether every joint lies within the soft (planning) limits, `tolerance` outside allowed.
+    pub fn within_soft_limits(&self, q: &[T; JOINTS], tolerance: T) -> bool {
+        (0..JOINTS).all(|i| q[i] >= self.soft_lower[i] - tolerance && q[i] <= self.soft_upper[i] + tolerance)
+    }
+
+    /// The frame turned by actuated joint `joint`.
+    pub fn joint_frame(&self, joint: usize) -> Option<usize> {
+        self.frames.iter().position(|f| f.joint == Some(joint))
+    }
+
+    /// Whether `ancestor` is `frame` or lies on its path to the root.
+    pub fn is_ancestor(&self, ancestor: usize, frame: usize) -> bool {
+        let mut f = frame;
+        for _ in 0..FRAMES {
+            if f == ancestor {
+                return true;
+            }
+            if f == 0 || f >= FRAMES {
+                return false;
+            }
+            f = self.frames[f].parent;
+        }
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tables_are_consistent() {
+        assert_eq!(JOINTS, 7);
+        for (i, f) in PANDA.frames.iter().enumerate().skip(1) {
+            assert!(f.parent < i, "frame {i} comes before its parent");
+        }
+        for j in 0..JOINTS {
+            assert!(PANDA.joint_frame(j).is_some());
+            assert!(PANDA.soft_lower[j] < PANDA.soft_upper[j]);
+            assert!(PANDA.hard_lower[j] <= PANDA.soft_lower[j] && PANDA.soft_upper[j] <= PANDA.hard_upper[j]);
+        }
+        for b in &PANDA_F64.bodies {
+            let r = b.rotation;
+            assert!((r.transpose() * r - Matrix3::identity()).norm() < 1e-9);
+            assert!(r.determinant() > 0.0);
+            assert!(b.half_extents.iter().all(|&h| h > 0.0));
+        }
+        assert_eq!(FRAME_NAMES[TCP_FRAME], "panda_grasptarget");
+        assert_eq!(FRAME_NAMES[HAND_FRAME], "panda_hand");
+        assert!(PANDA.is_ancestor(1, TCP_FRAME) && !PANDA.is_ancestor(10, TCP_FRAME));
+    }
+}
