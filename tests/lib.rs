@@ -51,10 +51,9 @@ pub fn gradient_scale(g: &CornerGradient<f32>) -> f64 {
 fn corner_objective(q: &[f64; JOINTS], g: &CornerGradient<f32>) -> f64 {
     let k = forward(q).expect("finite joints");
     let mut total = 0.0;
-    for b in 0..BODIES {
-        let corners = k.corners(b);
-        for c in 0..CORNERS {
-            total += corners[c].dot(&g[b][c].cast::<f64>());
+    for (b, grads) in g.iter().enumerate() {
+        for (corner, grad) in k.corners(b).iter().zip(grads.iter()) {
+            total += corner.dot(&grad.cast::<f64>());
         }
     }
     total

@@ -6,7 +6,7 @@
 
 use crate::math::{self, Mat3, Vec3};
 use crate::urdf::{Chain, FINGER_OPENING, Motion};
-use std::fmt::Write;
+use core::fmt::Write;
 
 /// Rust source of the robot tables. `source` is how the URDF is named in comments.
 pub fn robot_tables(chain: &Chain, source: &str) -> String {

@@ -241,7 +241,7 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
 
 fn normalised(v: &Vec3, joint: &str) -> Result<Vec3, String> {
     let n = math::norm(v);
-    if !(n > 0.0) || !n.is_finite() {
+    if n.is_nan() || n <= 0.0 || !n.is_finite() {
         return Err(format!("joint `{joint}`: axis {v:?} is not a direction"));
     }
     Ok([v[0] / n, v[1] / n, v[2] / n])

@@ -1,1 +1,75 @@
-fn main() {}
+//! FK and FK + adjoint timings (issue targets: FK ≤ 0.5 µs, FK + adjoint ≤ 1.5 µs per
+//! configuration on one core). Run: `cargo bench -p edmp-core --bench fk`.
+
+use core::hint::black_box;
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use edmp_core::kinematics::{CORNERS, CornerGradient, forward};
+use edmp_core::robot::{BODIES, JOINTS, PANDA};
+use nalgebra::Vector3;
+
+/// A fixed pseudo-random sequence in [0, 1) (splitmix-style), so the bench inputs are stable.
+fn unit_sequence(seed: u64, n: usize) -> Vec<f32> {
+    let mut s = seed;
+    (0..n)
+        .map(|_| {
+            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = s;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        })
+        .collect()
+}
+
+fn configurations(n: usize) -> Vec<[f32; JOINTS]> {
+    let u = unit_sequence(1, n * JOINTS);
+    (0..n)
+        .map(|c| {
+            core::array::from_fn(|j| {
+                PANDA.soft_lower[j] + u[c * JOINTS + j] * (PANDA.soft_upper[j] - PANDA.soft_lower[j])
+            })
+        })
+        .collect()
+}
+
+fn gradient() -> CornerGradient<f32> {
+    let u = unit_sequence(2, BODIES * CORNERS * 3);
+    core::array::from_fn(|b| {
+        core::array::from_fn(|c| {
+            let i = (b * CORNERS + c) * 3;
+            Vector3::new(u[i] - 0.5, u[i + 1] - 0.5, u[i + 2] - 0.5)
+        })
+    })
+}
+
+fn bench(c: &mut Criterion) {
+    let qs = configurations(600);
+    let g = gradient();
+    let mut group = c.benchmark_group("kinematics");
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("fk/1", |b| b.iter(|| forward(black_box(&qs[0]))));
+    group.bench_function("fk+corners/1", |b| {
+        b.iter(|| forward(black_box(&qs[0])).map(|k| k.all_corners()))
+    });
+    group.bench_function("fk+adjoint/1", |b| {
+        b.iter(|| forward(black_box(&qs[0])).and_then(|k| k.adjoint(black_box(&g))))
+    });
+    group.throughput(Throughput::Elements(qs.len() as u64));
+    group.bench_function("fk+adjoint/600 (12 trajectories x 50 waypoints)", |b| {
+        b.iter(|| {
+            let mut acc = [0.0f32; JOINTS];
+            for q in black_box(&qs) {
+                if let Ok(dq) = forward(q).and_then(|k| k.adjoint(&g)) {
+                    for (a, d) in acc.iter_mut().zip(dq) {
+                        *a += d;
+                    }
+                }
+            }
+            acc
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

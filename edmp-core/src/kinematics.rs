@@ -13,7 +13,7 @@
 
 use crate::error::Error;
 use crate::robot::{BODIES, FRAMES, JOINTS, Real, TCP_FRAME};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 /// A rigid transform: `world = rotation · local + translation`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,6 +39,12 @@ impl<T: Real> Pose<T> {
             rotation: self.rotation * rotation,
             translation: self.translation + self.rotation * translation,
         }
+    }
+
+    /// Orientation as a unit quaternion `[w, x, y, z]` (the order of the scene format).
+    pub fn quaternion_wxyz(&self) -> [T; 4] {
+        let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(self.rotation));
+        [q.w, q.i, q.j, q.k]
     }
 
     /// A point given in this frame, expressed in the world.

@@ -59,8 +59,12 @@ pub struct Robot<T> {
 include!(concat!(env!("OUT_DIR"), "/panda.rs"));
 
 /// The Panda in `f32`: what the planner uses.
+// The tables are written once at f64 precision; the compiler rounds each literal to f32 here.
+// URDF numbers such as the hardware limit -3.1416 are data, not approximations of π.
+#[allow(clippy::excessive_precision, clippy::approx_constant)]
 pub static PANDA: Robot<f32> = panda_tables!();
 /// The Panda in `f64`: for oracles (finite differences) and host-side tools.
+#[allow(clippy::approx_constant)]
 pub static PANDA_F64: Robot<f64> = panda_tables!();
 
 /// The scalar types the kinematics run in: `f32` (planner) and `f64` (oracles).

@@ -1,1 +1,35 @@
-fn main() {}
+//! `edmp-host`: the command line of edmp-rs. Planning math lives in `edmp-core`; this crate
+//! reads and writes files, checks input and names the bad field, and prints results.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+mod fk;
+
+/// EDMP motion planning for the Franka Panda.
+#[derive(Debug, Parser)]
+#[command(name = "edmp-host", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Forward kinematics: world pose of every link frame, collision box and the TCP.
+    Fk(fk::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Fk(args) => fk::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("edmp-host: {message}");
+            ExitCode::from(2)
+        }
+    }
+}
