@@ -16,7 +16,11 @@ fn every_box_holds_every_vertex_and_beats_the_aabb() {
     assert_eq!(chain.joints.len(), 7);
     assert_eq!(chain.bodies.len(), 11, "link0-7, hand and two fingers");
     for body in &chain.bodies {
-        assert!(body.tight.volume() <= body.aabb.volume() * (1.0 + 1e-12), "{}", body.name);
+        assert!(
+            body.tight.volume() <= body.aabb.volume() * (1.0 + 1e-12),
+            "{}",
+            body.name
+        );
         assert!(math::det(&body.tight.rotation) > 0.999_999, "{}", body.name);
     }
     // Containment, re-derived from the mesh files. The right finger's mesh is turned by its
@@ -26,10 +30,18 @@ fn every_box_holds_every_vertex_and_beats_the_aabb() {
         let mesh = panda_urdf().parent().unwrap().join(&body.mesh);
         let rt = math::transpose(&body.tight.rotation);
         for v in read_obj_vertices(&mesh).unwrap() {
-            let d = [v[0] - body.tight.center[0], v[1] - body.tight.center[1], v[2] - body.tight.center[2]];
+            let d = [
+                v[0] - body.tight.center[0],
+                v[1] - body.tight.center[1],
+                v[2] - body.tight.center[2],
+            ];
             let local = math::mul_vec(&rt, &d);
             for i in 0..3 {
-                assert!(local[i].abs() <= body.tight.half_extents[i] + 1e-9, "{}: vertex {v:?} outside", body.name);
+                assert!(
+                    local[i].abs() <= body.tight.half_extents[i] + 1e-9,
+                    "{}: vertex {v:?} outside",
+                    body.name
+                );
             }
         }
     }
@@ -55,8 +67,12 @@ fn changing_the_urdf_changes_the_tables() {
     let edited = original.replacen(r#"xyz="0 0 0.333""#, r#"xyz="0 0 0.343""#, 1);
     assert_ne!(edited, original, "the test's edit must apply");
     std::fs::write(dir.join("panda.urdf"), &edited).unwrap();
-    let before = edmp_codegen::generate_robot(&panda_urdf(), "panda.urdf").unwrap().source;
-    let after = edmp_codegen::generate_robot(&dir.join("panda.urdf"), "panda.urdf").unwrap().source;
+    let before = edmp_codegen::generate_robot(&panda_urdf(), "panda.urdf")
+        .unwrap()
+        .source;
+    let after = edmp_codegen::generate_robot(&dir.join("panda.urdf"), "panda.urdf")
+        .unwrap()
+        .source;
     std::fs::remove_dir_all(&dir).ok();
     assert_ne!(before, after);
     assert!(after.contains("Vector3::new(0.0, 0.0, 0.343)"));
@@ -66,7 +82,11 @@ fn changing_the_urdf_changes_the_tables() {
 fn malformed_urdf_is_a_clear_error() {
     let dir = std::env::temp_dir().join(format!("edmp-codegen-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("bad.urdf"), "<robot name=\"x\"><link name=\"a\"/><link name=\"b\"/></robot>").unwrap();
+    std::fs::write(
+        dir.join("bad.urdf"),
+        "<robot name=\"x\"><link name=\"a\"/><link name=\"b\"/></robot>",
+    )
+    .unwrap();
     let err = edmp_codegen::generate_robot(&dir.join("bad.urdf"), "bad.urdf").unwrap_err();
     std::fs::remove_dir_all(&dir).ok();
     assert!(err.contains("root link"), "{err}");

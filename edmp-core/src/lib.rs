@@ -21,5 +21,6 @@ extern crate std;
 pub mod error;
 pub mod kinematics;
 pub mod robot;
+pub mod scene;
 
 pub use error::Error;

@@ -1,0 +1,223 @@
+//! The planning scene: obstacles (cuboids, cylinders, spheres) in a fixed-capacity list, and an
+//! optional object held in the hand. Everything is validated on the way in, so the costs and
+//! the checker never see a NaN, a zero size or a non-rotation.
+
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+
+/// Default obstacle capacity of a [`Scene`].
+pub const MAX_OBSTACLES: usize = 64;
+
+/// How far a quaternion's norm may be from 1 (`spec/formats.md`); within it, it is normalised.
+pub const QUATERNION_NORM_TOLERANCE: f32 = 1e-3;
+
+/// The geometry of a primitive, in its own frame (centred at the origin).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// A box with full extents `dims` along its x, y, z.
+    Cuboid {
+        /// Full extents.
+        dims: Vector3<f32>,
+    },
+    /// A cylinder along its local z.
+    Cylinder {
+        /// Radius.
+        radius: f32,
+        /// Full length along z.
+        height: f32,
+    },
+    /// A ball.
+    Sphere {
+        /// Radius.
+        radius: f32,
+    },
+}
+
+/// A primitive placed in a frame: the world for obstacles, the hand for a held object.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Obstacle {
+    /// The geometry.
+    pub shape: Shape,
+    /// Centre.
+    pub center: Vector3<f32>,
+    /// Orientation (columns are the primitive's axes).
+    pub rotation: Matrix3<f32>,
+}
+
+/// Why an obstacle or a scene was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// A centre, size or quaternion component is NaN or infinite.
+    NonFinite,
+    /// The quaternion's norm is not within [`QUATERNION_NORM_TOLERANCE`] of 1.
+    QuaternionNorm,
+    /// A size (extent, radius, height) is zero or negative.
+    NonPositiveSize,
+    /// The scene already holds its capacity of obstacles.
+    TooManyObstacles,
+}
+
+impl core::fmt::Display for SceneError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::NonFinite => "value is not a finite number",
+            Self::QuaternionNorm => "quaternion norm is not within 1e-3 of 1",
+            Self::NonPositiveSize => "size must be positive",
+            Self::TooManyObstacles => "too many obstacles for the scene's capacity",
+        })
+    }
+}
+
+impl core::error::Error for SceneError {}
+
+fn finite(values: &[f32]) -> Result<(), SceneError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SceneError::NonFinite)
+    }
+}
+
+fn positive(values: &[f32]) -> Result<(), SceneError> {
+    finite(values)?;
+    if values.iter().all(|&v| v > 0.0) {
+        Ok(())
+    } else {
+        Err(SceneError::NonPositiveSize)
+    }
+}
+
+/// A quaternion `[w, x, y, z]` whose norm is within tolerance of 1, as a rotation matrix.
+pub fn rotation_from_wxyz(q: [f32; 4]) -> Result<Matrix3<f32>, SceneError> {
+    finite(&q)?;
+    let norm = libm::sqrtf(q.iter().map(|v| v * v).sum::<f32>());
+    if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+        return Err(SceneError::QuaternionNorm);
+    }
+    let unit = UnitQuaternion::new_unchecked(Quaternion::new(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm));
+    Ok(unit.to_rotation_matrix().into_inner())
+}
+
+impl Obstacle {
+    /// A cuboid with full extents `dims`, rotated by the quaternion `[w, x, y, z]`.
+    pub fn cuboid(center: [f32; 3], dims: [f32; 3], quaternion: [f32; 4]) -> Result<Self, SceneError> {
+        finite(&center)?;
+        positive(&dims)?;
+        let rotation = rotation_from_wxyz(quaternion)?;
+        Ok(Self {
+            shape: Shape::Cuboid { dims: dims.into() },
+            center: center.into(),
+            rotation,
+        })
+    }
+
+    /// A cylinder along its local z, rotated by the quaternion `[w, x, y, z]`.
+    pub fn cylinder(center: [f32; 3], radius: f32, height: f32, quaternion: [f32; 4]) -> Result<Self, SceneError> {
+        finite(&center)?;
+        positive(&[radius, height])?;
+        let rotation = rotation_from_wxyz(quaternion)?;
+        Ok(Self {
+            shape: Shape::Cylinder { radius, height },
+            center: center.into(),
+            rotation,
+        })
+    }
+
+    /// A sphere.
+    pub fn sphere(center: [f32; 3], radius: f32) -> Result<Self, SceneError> {
+        finite(&center)?;
+        positive(&[radius])?;
+        Ok(Self {
+            shape: Shape::Sphere { radius },
+            center: center.into(),
+            rotation: Matrix3::identity(),
+        })
+    }
+}
+
+/// Obstacles (at most `N`) and an optional object held in the hand (pose in the
+/// `panda_hand` frame).
+#[derive(Clone, Debug, Default)]
+pub struct Scene<const N: usize = MAX_OBSTACLES> {
+    obstacles: heapless::Vec<Obstacle, N>,
+    held: Option<Obstacle>,
+}
+
+impl<const N: usize> Scene<N> {
+    /// An empty scene.
+    pub const fn new() -> Self {
+        Self {
+            obstacles: heapless::Vec::new(),
+            held: None,
+        }
+    }
+
+    /// Adds an obstacle (already validated by its constructor).
+    pub fn push(&mut self, obstacle: Obstacle) -> Result<(), SceneError> {
+        self.obstacles.push(obstacle).map_err(|_| SceneError::TooManyObstacles)
+    }
+
+    /// Attaches `object` to the hand (its pose is in the `panda_hand` frame), replacing any other.
+    pub fn hold(&mut self, object: Obstacle) {
+        self.held = Some(object);
+    }
+
+    /// The obstacles.
+    pub fn obstacles(&self) -> &[Obstacle] {
+        &self.obstacles
+    }
+
+    /// The held object, if any.
+    pub fn held(&self) -> Option<&Obstacle> {
+        self.held.as_ref()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
+
+    #[test]
+    fn validates_each_field() {
+        assert!(Obstacle::cuboid([0.5, 0.0, 0.2], [0.4, 0.8, 0.02], ID).is_ok());
+        assert_eq!(
+            Obstacle::cuboid([f32::NAN, 0.0, 0.0], [1.0; 3], ID),
+            Err(SceneError::NonFinite)
+        );
+        assert_eq!(
+            Obstacle::cuboid([0.0; 3], [1.0, 0.0, 1.0], ID),
+            Err(SceneError::NonPositiveSize)
+        );
+        assert_eq!(
+            Obstacle::cuboid([0.0; 3], [1.0; 3], [0.7, 0.0, 0.0, 0.0]),
+            Err(SceneError::QuaternionNorm)
+        );
+        assert_eq!(
+            Obstacle::cylinder([0.0; 3], -0.1, 0.2, ID),
+            Err(SceneError::NonPositiveSize)
+        );
+        assert_eq!(Obstacle::sphere([0.0; 3], f32::INFINITY), Err(SceneError::NonFinite));
+    }
+
+    #[test]
+    fn near_unit_quaternions_are_normalised() {
+        let o = Obstacle::cuboid([0.0; 3], [1.0; 3], [1.0005, 0.0, 0.0, 0.0]).unwrap();
+        assert!((o.rotation - Matrix3::identity()).norm() < 1e-6);
+        // 90° about z: x goes to y.
+        let h = core::f32::consts::FRAC_1_SQRT_2;
+        let o = Obstacle::cuboid([0.0; 3], [1.0; 3], [h, 0.0, 0.0, h]).unwrap();
+        let x = o.rotation * Vector3::x();
+        assert!((x - Vector3::y()).norm() < 1e-6);
+    }
+
+    #[test]
+    fn capacity_is_a_typed_error() {
+        let mut s = Scene::<2>::new();
+        let o = Obstacle::sphere([0.0; 3], 0.1).unwrap();
+        assert!(s.push(o).is_ok() && s.push(o).is_ok());
+        assert_eq!(s.push(o), Err(SceneError::TooManyObstacles));
+        assert_eq!(s.obstacles().len(), 2);
+    }
+}
