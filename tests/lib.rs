@@ -98,3 +98,186 @@ pub fn check_adjoint(q: &[f32; JOINTS], g: &CornerGradient<f32>) -> Result<(), S
 pub fn zero_gradient() -> CornerGradient<f32> {
     [[Vector3::zeros(); CORNERS]; BODIES]
 }
+
+/// An independent f64 re-implementation of EDMP's costs (straight from the definitions, no
+/// shared code with `edmp_core::cost` beyond the f64 FK): the value, and a signature of every
+/// discrete choice (arg-extremal corners, positive overlaps, swept-bound ends), so a finite
+/// difference can be trusted only where the signature does not change across its stencil.
+pub mod reference {
+    use edmp_core::cost::{CostConfig, CostKind};
+    use edmp_core::geometry::box_dims;
+    use edmp_core::kinematics::forward;
+    use edmp_core::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
+    use edmp_core::scene::Scene;
+    use nalgebra::Vector3;
+    use core::hash::{Hash, Hasher};
+    use std::hash::DefaultHasher;
+
+    type Box3 = (Vector3<f64>, Vector3<f64>);
+
+    /// The discrete choices made so far, and how close the nearest of them came to flipping.
+    struct Choices {
+        sig: DefaultHasher,
+        margin: f64,
+    }
+
+    impl Choices {
+        fn record(&mut self, choice: impl Hash, gap: f64) {
+            choice.hash(&mut self.sig);
+            self.margin = self.margin.min(gap.abs());
+        }
+    }
+
+    fn aabb(points: &[Vector3<f64>], sig: &mut Choices) -> Box3 {
+        let mut lo = points[0];
+        let mut hi = points[0];
+        for p in points {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        for k in 0..3 {
+            // Which corner is extremal (a change means a kink in the cost), and by how much.
+            let amin = points.iter().position(|p| p[k] == lo[k]);
+            let amax = points.iter().position(|p| p[k] == hi[k]);
+            let runner_up = |best: f64, pick: Option<usize>| {
+                points
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| Some(*i) != pick)
+                    .map(|(_, p)| (p[k] - best).abs())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            sig.record((amin, amax), runner_up(lo[k], amin).min(runner_up(hi[k], amax)));
+        }
+        (lo, hi)
+    }
+
+    fn corners(center: Vector3<f64>, rot: nalgebra::Matrix3<f64>, half: Vector3<f64>) -> Vec<Vector3<f64>> {
+        (0..8)
+            .map(|k| {
+                let s = Vector3::new(
+                    if k & 1 == 1 { 1.0 } else { -1.0 },
+                    if k & 2 == 2 { 1.0 } else { -1.0 },
+                    if k & 4 == 4 { 1.0 } else { -1.0 },
+                );
+                center + rot * s.component_mul(&half)
+            })
+            .collect()
+    }
+
+    fn robot_boxes(q: &[f64; JOINTS], scene: &Scene<16>, cfg: &CostConfig, sig: &mut Choices) -> Vec<Box3> {
+        let k = forward(q).expect("finite");
+        let mut out = Vec::new();
+        for b in 0..BODIES {
+            if PANDA.bodies[b].frame == 0 {
+                continue;
+            }
+            out.push(aabb(&k.corners(b), sig));
+        }
+        if let Some(h) = scene.held() {
+            let half = box_dims(&h.shape, cfg.cylinder).cast::<f64>() * 0.5;
+            let hand = &k.frames[HAND_FRAME];
+            let local = corners(h.center.cast(), h.rotation.cast(), half);
+            let world: Vec<_> = local.iter().map(|p| hand.transform_point(p)).collect();
+            out.push(aabb(&world, sig));
+        }
+        out
+    }
+
+    fn volume(a: &Box3, o: &Box3, sig: &mut Choices) -> f64 {
+        let d = a.1.inf(&o.1) - a.0.sup(&o.0);
+        let positive = d.iter().all(|&x| x > 0.0);
+        // Where the boxes are apart, only the axis closest to touching matters.
+        let gap = if positive {
+            d.min()
+        } else {
+            d.iter().map(|x| -x).fold(0.0f64, f64::max)
+        };
+        sig.record(positive, gap);
+        if !positive {
+            return 0.0;
+        }
+        for k in 0..3 {
+            sig.record(
+                (a.1[k] < o.1[k], a.0[k] > o.0[k]),
+                (a.1[k] - o.1[k]).abs().min((a.0[k] - o.0[k]).abs()),
+            );
+        }
+        d.x * d.y * d.z
+    }
+
+    /// A cost evaluation: value, signature of its discrete choices, and the smallest gap by
+    /// which any choice was made (metres): a finite difference is trusted only away from kinks.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Evaluation {
+        /// The cost.
+        pub value: f64,
+        /// Hash of every discrete choice.
+        pub signature: u64,
+        /// Smallest gap of any choice.
+        pub margin: f64,
+    }
+
+    /// Evaluates the cost of `trajectory`.
+    pub fn cost(scene: &Scene<16>, trajectory: &[[f64; JOINTS]], cfg: &CostConfig) -> Evaluation {
+        let mut sig = Choices {
+            sig: DefaultHasher::new(),
+            margin: f64::INFINITY,
+        };
+        let obstacles: Vec<Box3> = scene
+            .obstacles()
+            .iter()
+            .map(|o| {
+                let dims = box_dims(&o.shape, cfg.cylinder)
+                    .cast::<f64>()
+                    .map(|d| d.max(f64::from(cfg.inflation.expansion)) + f64::from(cfg.inflation.clearance));
+                let pts = corners(o.center.cast(), o.rotation.cast(), dims * 0.5);
+                let mut lo = pts[0];
+                let mut hi = pts[0];
+                for p in &pts {
+                    lo = lo.inf(p);
+                    hi = hi.sup(p);
+                }
+                (lo, hi)
+            })
+            .collect();
+        let boxes: Vec<Vec<Box3>> = trajectory
+            .iter()
+            .map(|q| robot_boxes(q, scene, cfg, &mut sig))
+            .collect();
+        let h = trajectory.len();
+        let mut total = 0.0;
+        match cfg.kind {
+            CostKind::Intersection => {
+                for w in boxes.iter().take(h - 1).skip(1) {
+                    for b in w {
+                        for o in &obstacles {
+                            total += volume(b, o, &mut sig);
+                        }
+                    }
+                }
+            }
+            CostKind::Swept => {
+                for pair in boxes.windows(2) {
+                    for (a, b) in pair[0].iter().zip(pair[1].iter()) {
+                        for k in 0..3 {
+                            sig.record(
+                                (b.0[k] < a.0[k], b.1[k] > a.1[k]),
+                                (b.0[k] - a.0[k]).abs().min((b.1[k] - a.1[k]).abs()),
+                            );
+                        }
+                        let swept = (a.0.inf(&b.0), a.1.sup(&b.1));
+                        for o in &obstacles {
+                            total += volume(&swept, o, &mut sig);
+                        }
+                    }
+                }
+            }
+        }
+        Evaluation {
+            value: total,
+            signature: sig.sig.finish(),
+            margin: sig.margin,
+        }
+    }
+}

@@ -36,12 +36,8 @@ fn every_box_holds_every_vertex_and_beats_the_aabb() {
                 v[2] - body.tight.center[2],
             ];
             let local = math::mul_vec(&rt, &d);
-            for i in 0..3 {
-                assert!(
-                    local[i].abs() <= body.tight.half_extents[i] + 1e-9,
-                    "{}: vertex {v:?} outside",
-                    body.name
-                );
+            for (l, h) in local.iter().zip(body.tight.half_extents) {
+                assert!(l.abs() <= h + 1e-9, "{}: vertex {v:?} outside", body.name);
             }
         }
     }

@@ -13,8 +13,11 @@ pub enum Error {
     },
     /// An upstream gradient holds a NaN or infinite value.
     NonFiniteGradient,
-    /// The inputs were finite but the result overflowed (gradients near `f32::MAX`).
+    /// The inputs were finite but the result overflowed (gradients near `f32::MAX`, or
+    /// obstacles so large that their volumes do).
     Overflow,
+    /// A tuning parameter (clearance, expansion, ...) is negative or not finite.
+    BadParameter,
 }
 
 impl fmt::Display for Error {
@@ -23,6 +26,7 @@ impl fmt::Display for Error {
             Self::NonFiniteJoint { joint } => write!(f, "joint {joint} is not a finite number"),
             Self::NonFiniteGradient => f.write_str("upstream gradient is not finite"),
             Self::Overflow => f.write_str("result overflowed to a non-finite value"),
+            Self::BadParameter => f.write_str("a parameter is negative or not finite"),
         }
     }
 }

@@ -18,7 +18,9 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod cost;
 pub mod error;
+pub mod geometry;
 pub mod kinematics;
 pub mod robot;
 pub mod scene;
