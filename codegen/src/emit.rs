@@ -58,6 +58,9 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         w,
         &format!("pub const BODY_NAMES: [&str; BODIES] = [{}];", names.join(", ")),
     );
+    let hull_total: usize = chain.bodies.iter().map(|b| b.points.len()).sum();
+    wl(w, "/// Number of collision-mesh vertices kept for the exact checker (all bodies).");
+    wl(w, &format!("pub const HULL_POINTS: usize = {hull_total};"));
     wl(w, "/// URDF joint name of each actuated joint.");
     let names: Vec<_> = chain.joints.iter().map(|j| format!("{:?}", j.name)).collect();
     wl(
@@ -107,6 +110,7 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     }
     wl(w, "            ],");
     wl(w, "            bodies: [");
+    let mut hull_start = 0;
     for b in &chain.bodies {
         let shrink = 100.0 * (1.0 - b.tight.volume() / b.aabb.volume());
         wl(
@@ -126,6 +130,8 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         );
         wl(w, "                BodySpec {");
         wl(w, &format!("                    frame: {},", b.frame));
+        wl(w, &format!("                    hull_start: {hull_start},"));
+        wl(w, &format!("                    hull_len: {},", b.points.len()));
         wl(w, &format!("                    center: {},", vec3(&b.tight.center)));
         wl(
             w,
@@ -136,6 +142,16 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
             &format!("                    half_extents: {},", vec3(&b.tight.half_extents)),
         );
         wl(w, "                },");
+        hull_start += b.points.len();
+    }
+    wl(w, "            ],");
+    wl(w, "            hull_points: [");
+    for b in &chain.bodies {
+        let note = format!("{} distinct vertices of `{}` in its link frame", b.points.len(), b.mesh);
+        wl(w, &format!("                // `{}`: {note}", b.name));
+        for p in &b.points {
+            wl(w, &format!("                {},", vec3(p)));
+        }
     }
     wl(w, "            ],");
     let limits = |pick: &dyn Fn(usize) -> f64| (0..n_joints).map(|i| lit(pick(i))).collect::<Vec<_>>().join(", ");

@@ -60,6 +60,17 @@ pub fn parse_obj_vertices(text: &str) -> Result<Vec<Vec3>, String> {
     Ok(vertices)
 }
 
+/// `points` without exact repeats, first occurrence kept (meshes repeat shared vertices).
+pub fn distinct(points: &[Vec3]) -> Vec<Vec3> {
+    let mut out: Vec<Vec3> = Vec::new();
+    for p in points {
+        if !out.iter().any(|q| q == p) {
+            out.push(*p);
+        }
+    }
+    out
+}
+
 /// The axis-aligned box of `points` (what the original EDMP uses).
 pub fn aabb(points: &[Vec3]) -> OrientedBox {
     box_with_axes(points, &math::IDENTITY)

@@ -70,6 +70,9 @@ pub struct Body {
     pub tight: OrientedBox,
     /// The link-frame axis-aligned box (what the original EDMP uses), for comparison.
     pub aabb: OrientedBox,
+    /// The distinct mesh vertices in the link frame, in file order: their convex hull is
+    /// the body's exact collision geometry (PyBullet uses the same hull).
+    pub points: Vec<Vec3>,
 }
 
 /// Everything the generator knows of the robot.
@@ -218,6 +221,7 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
             vertex_count: points.len(),
             tight: mesh::tight_box(&points),
             aabb: mesh::aabb(&points),
+            points: mesh::distinct(&points),
         });
     }
 

@@ -18,6 +18,9 @@ pub enum Error {
     Overflow,
     /// A tuning parameter (clearance, expansion, ...) is negative or not finite.
     BadParameter,
+    /// Two consecutive waypoints are so far apart that interpolating them at the checker's
+    /// step would exceed its fixed budget of states per segment.
+    SegmentTooLong,
 }
 
 impl fmt::Display for Error {
@@ -27,6 +30,7 @@ impl fmt::Display for Error {
             Self::NonFiniteGradient => f.write_str("upstream gradient is not finite"),
             Self::Overflow => f.write_str("result overflowed to a non-finite value"),
             Self::BadParameter => f.write_str("a parameter is negative or not finite"),
+            Self::SegmentTooLong => f.write_str("consecutive waypoints are too far apart to interpolate"),
         }
     }
 }

@@ -18,9 +18,12 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod checker;
+pub mod convex;
 pub mod cost;
 pub mod error;
 pub mod geometry;
+pub mod gjk;
 pub mod kinematics;
 pub mod robot;
 pub mod scene;

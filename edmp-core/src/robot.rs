@@ -31,6 +31,10 @@ pub struct FrameSpec<T> {
 pub struct BodySpec<T> {
     /// Frame the box is attached to.
     pub frame: usize,
+    /// First of this body's collision-mesh vertices in `Robot::hull_points`.
+    pub hull_start: usize,
+    /// How many vertices: their convex hull is the body's exact geometry.
+    pub hull_len: usize,
     /// Box centre in that frame.
     pub center: Vector3<T>,
     /// Box axes (columns) in that frame.
@@ -46,6 +50,8 @@ pub struct Robot<T> {
     pub frames: [FrameSpec<T>; FRAMES],
     /// Collision bodies.
     pub bodies: [BodySpec<T>; BODIES],
+    /// Collision-mesh vertices of every body (link frame), sliced by `BodySpec::hull_start/len`.
+    pub hull_points: [Vector3<T>; HULL_POINTS],
     /// Franka's official lower joint limits (URDF `safety_controller`), used for planning.
     pub soft_lower: [T; JOINTS],
     /// Franka's official upper joint limits.
@@ -115,6 +121,14 @@ impl<T: Real> Robot<T> {
         self.frames.iter().position(|f| f.joint == Some(joint))
     }
 
+    /// The collision-mesh vertices of body `body` in its link frame (empty if out of range).
+    pub fn hull(&self, body: usize) -> &[Vector3<T>] {
+        self.bodies
+            .get(body)
+            .and_then(|b| self.hull_points.get(b.hull_start..b.hull_start + b.hull_len))
+            .unwrap_or(&[])
+    }
+
     /// Whether `ancestor` is `frame` or lies on its path to the root.
     pub fn is_ancestor(&self, ancestor: usize, frame: usize) -> bool {
         let mut f = frame;
@@ -151,6 +165,16 @@ mod tests {
             assert!((r.transpose() * r - Matrix3::identity()).norm() < 1e-9);
             assert!(r.determinant() > 0.0);
             assert!(b.half_extents.iter().all(|&h| h > 0.0));
+        }
+        for body in 0..BODIES {
+            let hull = PANDA_F64.hull(body);
+            assert!(hull.len() >= 4, "{}", BODY_NAMES[body]);
+            // Every vertex lies in the body's box (the box was fitted to them).
+            let b = &PANDA_F64.bodies[body];
+            for p in hull {
+                let local = b.rotation.transpose() * (p - b.center);
+                assert!((0..3).all(|k| local[k].abs() <= b.half_extents[k] + 1e-9), "{}", BODY_NAMES[body]);
+            }
         }
         assert_eq!(FRAME_NAMES[TCP_FRAME], "panda_grasptarget");
         assert_eq!(FRAME_NAMES[HAND_FRAME], "panda_hand");

@@ -1,0 +1,362 @@
+//! The exact collision checker: is a state, or a whole trajectory, free of contact?
+//!
+//! Geometry is exact, never boxed: each robot body is the convex hull of its collision mesh
+//! (the same hull PyBullet collides), obstacles and the held object are true cuboids,
+//! cylinders and spheres. A pair is declared free only when a GJK separating direction
+//! *certifies* a gap larger than the margin ([`crate::gjk::apart`]); anything else counts as
+//! contact. Cheap tests run first and can only prove freedom: bounding balls, then the body's
+//! oriented box (which holds its hull).
+//!
+//! Checked, as `spec/formats.md` defines a solved problem: every moving body (links 1-7, hand,
+//! fingers, held object) against every obstacle, and every pair of bodies that are not chain
+//! neighbours (link7, hand, fingers and held object form one rigid group), at every waypoint
+//! and at every state of the linear joint interpolation in steps of at most `max_step`.
+
+use crate::convex::{Hull, Primitive};
+use crate::error::Error;
+use crate::gjk::apart;
+use crate::kinematics::{Joints, Kinematics, forward};
+use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
+use crate::scene::{Scene, Shape};
+use nalgebra::{Matrix3, Vector3};
+
+/// Clearance every contact test demands (metres). PyBullet inflates each mesh hull by its
+/// collision margin and calls any distance ≤ 0 contact; this margin covers that, measured on
+/// the recorded fixtures (see the tests and ARCHITECTURE.md).
+pub const DEFAULT_MARGIN: f32 = 0.002;
+/// Largest joint step between checked states (`spec/formats.md`).
+pub const MAX_JOINT_STEP: f32 = 0.01;
+/// Fixed budget of interpolated states per segment: the widest joint range (6.6 rad) at
+/// 0.01 rad needs 664, so only waypoints outside the limits can exceed it.
+pub const MAX_STEPS_PER_SEGMENT: u32 = 1024;
+/// Index of the held object in [`Contact`] (robot bodies use `robot::BODY_NAMES` indices).
+pub const HELD_BODY: u8 = BODIES as u8;
+
+/// Checker settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CheckConfig {
+    /// Required clearance between any two checked shapes.
+    pub margin: f32,
+    /// Largest per-joint step between checked states.
+    pub max_step: f32,
+}
+
+impl Default for CheckConfig {
+    fn default() -> Self {
+        Self { margin: DEFAULT_MARGIN, max_step: MAX_JOINT_STEP }
+    }
+}
+
+/// What touched.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Contact {
+    /// Robot body (or [`HELD_BODY`]) `body` against obstacle `obstacle`.
+    Obstacle {
+        /// Body index.
+        body: u8,
+        /// Obstacle index in the scene.
+        obstacle: u8,
+    },
+    /// Two robot bodies that are not chain neighbours.
+    SelfContact {
+        /// Lower body index.
+        first: u8,
+        /// Higher body index (possibly [`HELD_BODY`]).
+        second: u8,
+    },
+}
+
+/// Where along a trajectory a contact was found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StateContact {
+    /// Segment index (waypoint `segment` to `segment + 1`); the last waypoint is step 0 of
+    /// segment `H − 1`.
+    pub segment: u16,
+    /// Interpolation step within the segment (0 is the waypoint itself).
+    pub step: u16,
+    /// What touched.
+    pub contact: Contact,
+}
+
+/// The verdict on a trajectory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TrajectoryReport {
+    /// States checked (waypoints and interpolated states).
+    pub states: u32,
+    /// States in contact (a measure of how bad a colliding trajectory is).
+    pub colliding_states: u32,
+    /// The first contact, if any.
+    pub first_contact: Option<StateContact>,
+}
+
+impl TrajectoryReport {
+    /// No state touched anything.
+    pub fn is_free(&self) -> bool {
+        self.colliding_states == 0
+    }
+}
+
+/// How many revolute joints lie between a frame and the root: bodies whose levels differ by
+/// at most one are chain neighbours (the hand and fingers share link7's level).
+fn level(frame: usize) -> u8 {
+    let mut f = frame.min(FRAMES - 1);
+    let mut joints = 0u8;
+    for _ in 0..FRAMES {
+        if PANDA.frames[f].joint.is_some() {
+            joints += 1;
+        }
+        if f == 0 {
+            break;
+        }
+        f = PANDA.frames[f].parent;
+    }
+    joints
+}
+
+fn body_level(body: usize) -> u8 {
+    if body < BODIES { level(PANDA.bodies[body].frame) } else { level(HAND_FRAME) }
+}
+
+fn moves(body: usize) -> bool {
+    body >= BODIES || PANDA.bodies[body].frame != 0
+}
+
+const PLACEHOLDER: Primitive = Primitive {
+    shape: Shape::Sphere { radius: 0.0 },
+    rotation: Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+    center: Vector3::new(0.0, 0.0, 0.0),
+};
+
+/// One state's shapes, placed.
+struct Placed<'a> {
+    k: &'a Kinematics<f32>,
+    held: Option<Primitive>,
+    margin: f32,
+}
+
+impl Placed<'_> {
+    /// Centre and radius of a ball around body `b` (its oriented box, or the held object).
+    fn ball(&self, b: usize) -> (Vector3<f32>, f32) {
+        match (b < BODIES, &self.held) {
+            (true, _) => (self.k.boxes[b].translation, libm::sqrtf(PANDA.bodies[b].half_extents.norm_squared())),
+            (false, Some(h)) => (h.center, h.bounding_radius()),
+            (false, None) => (Vector3::zeros(), 0.0),
+        }
+    }
+
+    fn balls_apart(&self, (c1, r1): (Vector3<f32>, f32), (c2, r2): (Vector3<f32>, f32)) -> bool {
+        let reach = r1 + r2 + self.margin;
+        (c1 - c2).norm_squared() > reach * reach
+    }
+
+    fn obb(&self, b: usize) -> Primitive {
+        Primitive::cuboid(&self.k.boxes[b], &PANDA.bodies[b].half_extents)
+    }
+
+    fn hull(&self, b: usize) -> Hull<'_> {
+        Hull { pose: &self.k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)], points: PANDA.hull(b) }
+    }
+
+    /// Body `b` (robot or held) proven apart from primitive `p`.
+    fn body_apart_from(&self, b: usize, p: &Primitive) -> bool {
+        if b >= BODIES {
+            return self.held.as_ref().is_none_or(|h| apart(h, p, self.margin));
+        }
+        apart(&self.obb(b), p, self.margin) || apart(&self.hull(b), p, self.margin)
+    }
+
+    /// Bodies `a < b` proven apart.
+    fn bodies_apart(&self, a: usize, b: usize) -> bool {
+        if b >= BODIES {
+            return match &self.held {
+                Some(h) => self.body_apart_from(a, h),
+                None => true,
+            };
+        }
+        apart(&self.obb(a), &self.obb(b), self.margin) || apart(&self.hull(a), &self.hull(b), self.margin)
+    }
+}
+
+fn validate(config: &CheckConfig) -> Result<(), Error> {
+    let ok = config.margin.is_finite() && config.margin >= 0.0 && config.max_step.is_finite() && config.max_step > 0.0;
+    if ok { Ok(()) } else { Err(Error::BadParameter) }
+}
+
+fn obstacle_primitives<const N: usize>(scene: &Scene<N>) -> [Primitive; N] {
+    core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Primitive::obstacle))
+}
+
+fn contact_at<const N: usize>(
+    scene: &Scene<N>,
+    obstacles: &[Primitive],
+    q: &Joints<f32>,
+    margin: f32,
+) -> Result<Option<Contact>, Error> {
+    let k = forward(q)?;
+    let placed = Placed { k: &k, held: scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME])), margin };
+    let bodies = if placed.held.is_some() { BODIES + 1 } else { BODIES };
+    for b in (0..bodies).filter(|&b| moves(b)) {
+        let ball = placed.ball(b);
+        for (i, o) in obstacles.iter().enumerate() {
+            if placed.balls_apart(ball, (o.center, o.bounding_radius())) || placed.body_apart_from(b, o) {
+                continue;
+            }
+            return Ok(Some(Contact::Obstacle { body: b as u8, obstacle: i as u8 }));
+        }
+    }
+    for a in 0..bodies {
+        for b in a + 1..bodies {
+            if body_level(a).abs_diff(body_level(b)) <= 1 {
+                continue;
+            }
+            if placed.balls_apart(placed.ball(a), placed.ball(b)) || placed.bodies_apart(a, b) {
+                continue;
+            }
+            return Ok(Some(Contact::SelfContact { first: a as u8, second: b as u8 }));
+        }
+    }
+    Ok(None)
+}
+
+/// Checks one configuration: the first contact found, or `None` when every pair is proven
+/// apart by more than the margin.
+pub fn check_state<const N: usize>(
+    scene: &Scene<N>,
+    q: &Joints<f32>,
+    config: &CheckConfig,
+) -> Result<Option<Contact>, Error> {
+    validate(config)?;
+    let obstacles = obstacle_primitives(scene);
+    contact_at(scene, &obstacles[..scene.obstacles().len()], q, config.margin)
+}
+
+/// Checks every waypoint and every interpolated state between consecutive waypoints.
+/// With `stop_at_first`, returns at the first contact (the report then counts states only up
+/// to it); otherwise counts every colliding state.
+pub fn check_trajectory<const H: usize, const N: usize>(
+    scene: &Scene<N>,
+    trajectory: &[Joints<f32>; H],
+    config: &CheckConfig,
+    stop_at_first: bool,
+) -> Result<TrajectoryReport, Error> {
+    validate(config)?;
+    let obstacles = obstacle_primitives(scene);
+    let obstacles = &obstacles[..scene.obstacles().len()];
+    let mut report = TrajectoryReport { states: 0, colliding_states: 0, first_contact: None };
+    for (segment, q) in trajectory.iter().enumerate() {
+        let next = trajectory.get(segment + 1);
+        let steps = match next {
+            Some(b) => segment_steps(q, b, config.max_step)?,
+            None => 1,
+        };
+        for step in 0..steps {
+            let state = match next {
+                Some(b) => interpolate(q, b, step, steps),
+                None => *q,
+            };
+            report.states += 1;
+            if let Some(contact) = contact_at(scene, obstacles, &state, config.margin)? {
+                report.colliding_states += 1;
+                if report.first_contact.is_none() {
+                    report.first_contact = Some(StateContact { segment: segment as u16, step: step as u16, contact });
+                }
+                if stop_at_first {
+                    return Ok(report);
+                }
+            }
+        }
+    }
+    Ok(report)
+}
+
+/// Number of states (the start included, the end excluded) that keep every joint step ≤ `max_step`.
+fn segment_steps(a: &Joints<f32>, b: &Joints<f32>, max_step: f32) -> Result<u32, Error> {
+    let mut widest = 0.0f32;
+    for (x, y) in a.iter().zip(b.iter()) {
+        let d = (y - x).abs();
+        if !d.is_finite() {
+            return Err(Error::NonFiniteJoint { joint: 0 });
+        }
+        widest = widest.max(d);
+    }
+    let steps = libm::ceilf(widest / max_step).max(1.0);
+    if steps > MAX_STEPS_PER_SEGMENT as f32 {
+        return Err(Error::SegmentTooLong);
+    }
+    Ok(steps as u32)
+}
+
+fn interpolate(a: &Joints<f32>, b: &Joints<f32>, step: u32, steps: u32) -> Joints<f32> {
+    let t = step as f32 / steps as f32;
+    core::array::from_fn(|j| if j < JOINTS { a[j] + (b[j] - a[j]) * t } else { a[j] })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Obstacle;
+
+    const READY: [f32; 7] = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
+    const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
+
+    #[test]
+    fn ready_pose_in_an_empty_scene_is_free() {
+        let scene = Scene::<4>::new();
+        assert_eq!(check_state(&scene, &READY, &CheckConfig::default()), Ok(None));
+    }
+
+    #[test]
+    fn a_box_on_the_hand_is_contact_and_far_away_is_free() {
+        let k = forward(&READY).unwrap();
+        let hand = k.frames[HAND_FRAME].translation;
+        let mut scene = Scene::<4>::new();
+        scene.push(Obstacle::cuboid(hand.into(), [0.05; 3], ID).unwrap()).unwrap();
+        let contact = check_state(&scene, &READY, &CheckConfig::default()).unwrap();
+        assert!(matches!(contact, Some(Contact::Obstacle { obstacle: 0, .. })), "{contact:?}");
+        let mut far = Scene::<4>::new();
+        far.push(Obstacle::sphere([2.0, 2.0, 2.0], 0.1).unwrap()).unwrap();
+        assert_eq!(check_state(&far, &READY, &CheckConfig::default()), Ok(None));
+    }
+
+    #[test]
+    fn the_fixed_base_is_not_checked_against_obstacles() {
+        // A table top flush with link0's footprint touches only the fixed base.
+        let mut scene = Scene::<4>::new();
+        scene.push(Obstacle::cuboid([0.0, 0.0, -0.01], [0.3, 0.3, 0.02], ID).unwrap()).unwrap();
+        assert_eq!(check_state(&scene, &READY, &CheckConfig::default()), Ok(None));
+    }
+
+    #[test]
+    fn interpolation_catches_a_thin_wall_between_free_waypoints() {
+        // Swing joint 1 through a thin wall that neither end touches.
+        let a = [-1.2, -0.3, 0.0, -2.0, 0.0, 1.8, 0.785];
+        let b = [1.2, -0.3, 0.0, -2.0, 0.0, 1.8, 0.785];
+        let mut scene = Scene::<4>::new();
+        scene.push(Obstacle::cuboid([0.6, 0.0, 0.5], [0.4, 0.005, 0.4], ID).unwrap()).unwrap();
+        let cfg = CheckConfig::default();
+        assert_eq!(check_state(&scene, &a, &cfg), Ok(None));
+        assert_eq!(check_state(&scene, &b, &cfg), Ok(None));
+        let report = check_trajectory(&scene, &[a, b], &cfg, false).unwrap();
+        assert!(!report.is_free());
+        // 2.4 rad at 0.01 rad: 240 steps (241 after f32 rounding of the quotient) plus the end.
+        assert!((241..=242).contains(&report.states), "{}", report.states);
+    }
+
+    #[test]
+    fn self_contact_when_the_hand_folds_onto_the_base() {
+        // Joint 4 at its lower limit with joint 2 forward folds link7/hand towards link1-2.
+        let folded = [0.0, 1.7, 0.0, -3.07, 0.0, 0.0, 0.0];
+        let contact = check_state(&Scene::<1>::new(), &folded, &CheckConfig::default()).unwrap();
+        assert!(matches!(contact, Some(Contact::SelfContact { .. })), "{contact:?}");
+    }
+
+    #[test]
+    fn bad_settings_and_huge_segments_are_errors() {
+        let scene = Scene::<1>::new();
+        let cfg = CheckConfig { margin: -1.0, ..CheckConfig::default() };
+        assert_eq!(check_state(&scene, &READY, &cfg), Err(Error::BadParameter));
+        let mut far = READY;
+        far[0] = 100.0;
+        assert_eq!(check_trajectory(&scene, &[READY, far], &CheckConfig::default(), true), Err(Error::SegmentTooLong));
+    }
+}

@@ -1,0 +1,241 @@
+//! GJK: the distance between two convex sets, and a certificate that they are apart.
+//!
+//! [`closest`] runs the Gilbert-Johnson-Keerthi iteration on the Minkowski difference `A − B`
+//! to find (nearly) its point closest to the origin. The checker never trusts that number on
+//! its own: [`gap_along`] turns the direction GJK found into an exact lower bound on the
+//! distance (two support evaluations: `min⟨a, n⟩ − max⟨b, n⟩`), so a pair is declared apart only
+//! when a separating direction proves it. A GJK that stalls or hits its iteration cap can make
+//! the checker call a free pair colliding, never the other way round.
+
+use crate::convex::Convex;
+use nalgebra::Vector3;
+
+/// Iteration cap of [`closest`]; well above what polytopes of a few hundred vertices need.
+pub const MAX_ITERATIONS: usize = 48;
+
+type V = Vector3<f32>;
+
+fn support<A: Convex, B: Convex>(a: &A, b: &B, d: &V) -> V {
+    a.support(d) - b.support(&-d)
+}
+
+/// A vector `v = a − b` of the Minkowski difference near its point closest to the origin
+/// (`|v|` is an upper bound on the distance), or `None` when the origin lies inside the
+/// simplex built so far (the sets overlap or touch).
+pub fn closest<A: Convex, B: Convex>(a: &A, b: &B) -> Option<V> {
+    let mut simplex = [V::zeros(); 4];
+    let mut v = support(a, b, &V::x());
+    simplex[0] = v;
+    let mut n = 1;
+    for _ in 0..MAX_ITERATIONS {
+        let vv = v.norm_squared();
+        if vv <= 1e-14 {
+            return None;
+        }
+        let w = support(a, b, &-v);
+        // Converged: the new support point brings no real progress towards the origin.
+        if vv - v.dot(&w) <= 1e-6 * vv || simplex[..n].contains(&w) {
+            return Some(v);
+        }
+        simplex[n] = w;
+        n += 1;
+        let (point, kept) = nearest_on_simplex(&simplex[..n]);
+        if kept.len == 4 {
+            return None;
+        }
+        let mut next = [V::zeros(); 4];
+        for (slot, &i) in next.iter_mut().zip(kept.index[..kept.len].iter()) {
+            *slot = simplex[usize::from(i)];
+        }
+        simplex = next;
+        n = kept.len;
+        v = point;
+    }
+    Some(v)
+}
+
+/// Exact lower bound on the distance between `a` and `b` along the unit direction `n`
+/// (pointing from `b` towards `a`): `min⟨a, n⟩ − max⟨b, n⟩`. Positive means separated by at
+/// least that much.
+pub fn gap_along<A: Convex, B: Convex>(a: &A, b: &B, n: &V) -> f32 {
+    a.support(&-n).dot(n) - b.support(n).dot(n)
+}
+
+/// Whether `a` and `b` are proven to be more than `margin` apart.
+pub fn apart<A: Convex, B: Convex>(a: &A, b: &B, margin: f32) -> bool {
+    match closest(a, b) {
+        None => false,
+        Some(v) => {
+            let len = libm::sqrtf(v.norm_squared());
+            len > 0.0 && gap_along(a, b, &(v / len)) > margin
+        }
+    }
+}
+
+/// A certified lower bound on the distance between `a` and `b` (zero when they may touch).
+pub fn distance_lower_bound<A: Convex, B: Convex>(a: &A, b: &B) -> f32 {
+    match closest(a, b) {
+        None => 0.0,
+        Some(v) => {
+            let len = libm::sqrtf(v.norm_squared());
+            if len > 0.0 { gap_along(a, b, &(v / len)).max(0.0) } else { 0.0 }
+        }
+    }
+}
+
+/// Which simplex vertices support the nearest point.
+#[derive(Clone, Copy, Debug)]
+struct Kept {
+    index: [u8; 4],
+    len: usize,
+}
+
+impl Kept {
+    fn of(indices: &[u8]) -> Self {
+        let mut index = [0; 4];
+        index[..indices.len()].copy_from_slice(indices);
+        Self { index, len: indices.len() }
+    }
+}
+
+/// Point of the simplex (1-4 vertices) nearest the origin, and the vertices of the face it lies on.
+fn nearest_on_simplex(s: &[V]) -> (V, Kept) {
+    match s.len() {
+        1 => (s[0], Kept::of(&[0])),
+        2 => nearest_on_segment(s, [0, 1]),
+        3 => nearest_on_triangle(s, [0, 1, 2]),
+        _ => nearest_on_tetrahedron(s),
+    }
+}
+
+fn nearest_on_segment(s: &[V], [i, j]: [u8; 2]) -> (V, Kept) {
+    let (a, b) = (s[usize::from(i)], s[usize::from(j)]);
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    if len2 <= 0.0 {
+        return (a, Kept::of(&[i]));
+    }
+    let t = -a.dot(&ab) / len2;
+    if t <= 0.0 {
+        (a, Kept::of(&[i]))
+    } else if t >= 1.0 {
+        (b, Kept::of(&[j]))
+    } else {
+        (a + ab * t, Kept::of(&[i, j]))
+    }
+}
+
+/// Ericson, *Real-Time Collision Detection* §5.1.5, with the query point at the origin.
+fn nearest_on_triangle(s: &[V], [i, j, k]: [u8; 3]) -> (V, Kept) {
+    let (a, b, c) = (s[usize::from(i)], s[usize::from(j)], s[usize::from(k)]);
+    let (ab, ac, ap) = (b - a, c - a, -a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, Kept::of(&[i]));
+    }
+    let bp = -b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, Kept::of(&[j]));
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let t = d1 / (d1 - d3);
+        return (a + ab * t, Kept::of(&[i, j]));
+    }
+    let cp = -c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, Kept::of(&[k]));
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let t = d2 / (d2 - d6);
+        return (a + ac * t, Kept::of(&[i, k]));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + (c - b) * t, Kept::of(&[j, k]));
+    }
+    let sum = va + vb + vc;
+    if !(sum > 0.0) || !sum.is_finite() {
+        // Degenerate (flat) triangle: fall back to its best edge.
+        return best_of([nearest_on_segment(s, [i, j]), nearest_on_segment(s, [i, k]), nearest_on_segment(s, [j, k])]);
+    }
+    let (v, w) = (vb / sum, vc / sum);
+    (a + ab * v + ac * w, Kept::of(&[i, j, k]))
+}
+
+fn best_of<const M: usize>(candidates: [(V, Kept); M]) -> (V, Kept) {
+    let mut best = candidates[0];
+    for c in candidates.iter().skip(1) {
+        if c.0.norm_squared() < best.0.norm_squared() {
+            best = *c;
+        }
+    }
+    best
+}
+
+fn nearest_on_tetrahedron(s: &[V]) -> (V, Kept) {
+    let faces: [[u8; 4]; 4] = [[0, 1, 2, 3], [0, 1, 3, 2], [0, 2, 3, 1], [1, 2, 3, 0]];
+    let mut best: Option<(V, Kept)> = None;
+    let mut inside = true;
+    for [i, j, k, opposite] in faces {
+        let (a, b, c, d) = (s[usize::from(i)], s[usize::from(j)], s[usize::from(k)], s[usize::from(opposite)]);
+        let normal = (b - a).cross(&(c - a));
+        let origin_side = (-a).dot(&normal);
+        let other_side = (d - a).dot(&normal);
+        // The origin is outside this face when it is not on the opposite vertex's side.
+        if origin_side * other_side < 0.0 || other_side == 0.0 {
+            inside = false;
+            let candidate = nearest_on_triangle(s, [i, j, k]);
+            if best.is_none_or(|b| candidate.0.norm_squared() < b.0.norm_squared()) {
+                best = Some(candidate);
+            }
+        }
+    }
+    match best {
+        Some(b) if !inside => b,
+        _ => (V::zeros(), Kept::of(&[0, 1, 2, 3])),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::convex::Primitive;
+    use crate::scene::Obstacle;
+
+    const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
+
+    #[test]
+    fn sphere_distances_are_exact() {
+        let a = Primitive::obstacle(&Obstacle::sphere([0.0; 3], 0.5).unwrap());
+        let b = Primitive::obstacle(&Obstacle::sphere([2.0, 0.0, 0.0], 0.25).unwrap());
+        assert!((distance_lower_bound(&a, &b) - 1.25).abs() < 1e-5);
+        assert!(apart(&a, &b, 1.2) && !apart(&a, &b, 1.3));
+        let c = Primitive::obstacle(&Obstacle::sphere([0.6, 0.0, 0.0], 0.25).unwrap());
+        assert!(!apart(&a, &c, 0.0));
+    }
+
+    #[test]
+    fn rotated_boxes() {
+        let h = core::f32::consts::FRAC_1_SQRT_2;
+        let (w, z) = (libm::cosf(core::f32::consts::PI / 8.0), libm::sinf(core::f32::consts::PI / 8.0));
+        // A unit cube turned 45° about z reaches sqrt(0.5) along x.
+        let a = Primitive::obstacle(&Obstacle::cuboid([0.0; 3], [1.0; 3], [w, 0.0, 0.0, z]).unwrap());
+        let b = Primitive::obstacle(&Obstacle::cuboid([1.5, 0.0, 0.0], [1.0; 3], ID).unwrap());
+        let d = distance_lower_bound(&a, &b);
+        assert!((d - (1.0 - h)).abs() < 1e-4, "{d}");
+        let c = Primitive::obstacle(&Obstacle::cuboid([1.2, 0.0, 0.0], [1.0; 3], ID).unwrap());
+        assert!(!apart(&a, &c, 0.0));
+    }
+
+    #[test]
+    fn cylinder_against_box_edge_on() {
+        let cyl = Primitive::obstacle(&Obstacle::cylinder([0.0; 3], 0.1, 1.0, ID).unwrap());
+        let b = Primitive::obstacle(&Obstacle::cuboid([0.3, 0.0, 0.0], [0.2; 3], ID).unwrap());
+        assert!((distance_lower_bound(&cyl, &b) - 0.1).abs() < 1e-4);
+    }
+}
