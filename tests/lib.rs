@@ -104,13 +104,13 @@ pub fn zero_gradient() -> CornerGradient<f32> {
 /// discrete choice (arg-extremal corners, positive overlaps, swept-bound ends), so a finite
 /// difference can be trusted only where the signature does not change across its stencil.
 pub mod reference {
+    use core::hash::{Hash, Hasher};
     use edmp_core::cost::{CostConfig, CostKind};
     use edmp_core::geometry::box_dims;
     use edmp_core::kinematics::forward;
     use edmp_core::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
     use edmp_core::scene::Scene;
     use nalgebra::Vector3;
-    use core::hash::{Hash, Hasher};
     use std::hash::DefaultHasher;
 
     type Box3 = (Vector3<f64>, Vector3<f64>);

@@ -59,7 +59,10 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         &format!("pub const BODY_NAMES: [&str; BODIES] = [{}];", names.join(", ")),
     );
     let hull_total: usize = chain.bodies.iter().map(|b| b.points.len()).sum();
-    wl(w, "/// Number of collision-mesh vertices kept for the exact checker (all bodies).");
+    wl(
+        w,
+        "/// Number of collision-mesh vertices kept for the exact checker (all bodies).",
+    );
     wl(w, &format!("pub const HULL_POINTS: usize = {hull_total};"));
     wl(w, "/// URDF joint name of each actuated joint.");
     let names: Vec<_> = chain.joints.iter().map(|j| format!("{:?}", j.name)).collect();

@@ -14,7 +14,7 @@
 
 use crate::convex::{Hull, Primitive};
 use crate::error::Error;
-use crate::gjk::apart;
+use crate::gjk::{apart, distance_lower_bound};
 use crate::kinematics::{Joints, Kinematics, forward};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Scene, Shape};
@@ -39,11 +39,18 @@ pub struct CheckConfig {
     pub margin: f32,
     /// Largest per-joint step between checked states.
     pub max_step: f32,
+    /// Check non-neighbour robot bodies against each other (on by default; off only to study
+    /// obstacle contact alone).
+    pub self_collision: bool,
 }
 
 impl Default for CheckConfig {
     fn default() -> Self {
-        Self { margin: DEFAULT_MARGIN, max_step: MAX_JOINT_STEP }
+        Self {
+            margin: DEFAULT_MARGIN,
+            max_step: MAX_JOINT_STEP,
+            self_collision: true,
+        }
     }
 }
 
@@ -114,7 +121,11 @@ fn level(frame: usize) -> u8 {
 }
 
 fn body_level(body: usize) -> u8 {
-    if body < BODIES { level(PANDA.bodies[body].frame) } else { level(HAND_FRAME) }
+    if body < BODIES {
+        level(PANDA.bodies[body].frame)
+    } else {
+        level(HAND_FRAME)
+    }
 }
 
 fn moves(body: usize) -> bool {
@@ -138,7 +149,10 @@ impl Placed<'_> {
     /// Centre and radius of a ball around body `b` (its oriented box, or the held object).
     fn ball(&self, b: usize) -> (Vector3<f32>, f32) {
         match (b < BODIES, &self.held) {
-            (true, _) => (self.k.boxes[b].translation, libm::sqrtf(PANDA.bodies[b].half_extents.norm_squared())),
+            (true, _) => (
+                self.k.boxes[b].translation,
+                libm::sqrtf(PANDA.bodies[b].half_extents.norm_squared()),
+            ),
             (false, Some(h)) => (h.center, h.bounding_radius()),
             (false, None) => (Vector3::zeros(), 0.0),
         }
@@ -154,7 +168,10 @@ impl Placed<'_> {
     }
 
     fn hull(&self, b: usize) -> Hull<'_> {
-        Hull { pose: &self.k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)], points: PANDA.hull(b) }
+        Hull {
+            pose: &self.k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
+            points: PANDA.hull(b),
+        }
     }
 
     /// Body `b` (robot or held) proven apart from primitive `p`.
@@ -190,10 +207,15 @@ fn contact_at<const N: usize>(
     scene: &Scene<N>,
     obstacles: &[Primitive],
     q: &Joints<f32>,
-    margin: f32,
+    config: &CheckConfig,
 ) -> Result<Option<Contact>, Error> {
     let k = forward(q)?;
-    let placed = Placed { k: &k, held: scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME])), margin };
+    let margin = config.margin;
+    let placed = Placed {
+        k: &k,
+        held: scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME])),
+        margin,
+    };
     let bodies = if placed.held.is_some() { BODIES + 1 } else { BODIES };
     for b in (0..bodies).filter(|&b| moves(b)) {
         let ball = placed.ball(b);
@@ -201,8 +223,14 @@ fn contact_at<const N: usize>(
             if placed.balls_apart(ball, (o.center, o.bounding_radius())) || placed.body_apart_from(b, o) {
                 continue;
             }
-            return Ok(Some(Contact::Obstacle { body: b as u8, obstacle: i as u8 }));
+            return Ok(Some(Contact::Obstacle {
+                body: b as u8,
+                obstacle: i as u8,
+            }));
         }
+    }
+    if !config.self_collision {
+        return Ok(None);
     }
     for a in 0..bodies {
         for b in a + 1..bodies {
@@ -212,7 +240,10 @@ fn contact_at<const N: usize>(
             if placed.balls_apart(placed.ball(a), placed.ball(b)) || placed.bodies_apart(a, b) {
                 continue;
             }
-            return Ok(Some(Contact::SelfContact { first: a as u8, second: b as u8 }));
+            return Ok(Some(Contact::SelfContact {
+                first: a as u8,
+                second: b as u8,
+            }));
         }
     }
     Ok(None)
@@ -227,7 +258,29 @@ pub fn check_state<const N: usize>(
 ) -> Result<Option<Contact>, Error> {
     validate(config)?;
     let obstacles = obstacle_primitives(scene);
-    contact_at(scene, &obstacles[..scene.obstacles().len()], q, config.margin)
+    contact_at(scene, &obstacles[..scene.obstacles().len()], q, config)
+}
+
+/// A certified lower bound on the distance from the moving robot bodies' hulls (and the held
+/// object) to the nearest obstacle: zero when something may touch. Obstacles only; for
+/// diagnostics and for choosing among states that are all free.
+pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f32, Error> {
+    let k = forward(q)?;
+    let held = scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME]));
+    let mut best = f32::INFINITY;
+    for o in scene.obstacles().iter().map(Primitive::obstacle) {
+        for b in (0..BODIES).filter(|&b| moves(b)) {
+            let hull = Hull {
+                pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
+                points: PANDA.hull(b),
+            };
+            best = best.min(distance_lower_bound(&hull, &o));
+        }
+        if let Some(h) = &held {
+            best = best.min(distance_lower_bound(h, &o));
+        }
+    }
+    Ok(best)
 }
 
 /// Checks every waypoint and every interpolated state between consecutive waypoints.
@@ -242,7 +295,11 @@ pub fn check_trajectory<const H: usize, const N: usize>(
     validate(config)?;
     let obstacles = obstacle_primitives(scene);
     let obstacles = &obstacles[..scene.obstacles().len()];
-    let mut report = TrajectoryReport { states: 0, colliding_states: 0, first_contact: None };
+    let mut report = TrajectoryReport {
+        states: 0,
+        colliding_states: 0,
+        first_contact: None,
+    };
     for (segment, q) in trajectory.iter().enumerate() {
         let next = trajectory.get(segment + 1);
         let steps = match next {
@@ -255,10 +312,14 @@ pub fn check_trajectory<const H: usize, const N: usize>(
                 None => *q,
             };
             report.states += 1;
-            if let Some(contact) = contact_at(scene, obstacles, &state, config.margin)? {
+            if let Some(contact) = contact_at(scene, obstacles, &state, config)? {
                 report.colliding_states += 1;
                 if report.first_contact.is_none() {
-                    report.first_contact = Some(StateContact { segment: segment as u16, step: step as u16, contact });
+                    report.first_contact = Some(StateContact {
+                        segment: segment as u16,
+                        step: step as u16,
+                        contact,
+                    });
                 }
                 if stop_at_first {
                     return Ok(report);
@@ -310,9 +371,14 @@ mod tests {
         let k = forward(&READY).unwrap();
         let hand = k.frames[HAND_FRAME].translation;
         let mut scene = Scene::<4>::new();
-        scene.push(Obstacle::cuboid(hand.into(), [0.05; 3], ID).unwrap()).unwrap();
+        scene
+            .push(Obstacle::cuboid(hand.into(), [0.05; 3], ID).unwrap())
+            .unwrap();
         let contact = check_state(&scene, &READY, &CheckConfig::default()).unwrap();
-        assert!(matches!(contact, Some(Contact::Obstacle { obstacle: 0, .. })), "{contact:?}");
+        assert!(
+            matches!(contact, Some(Contact::Obstacle { obstacle: 0, .. })),
+            "{contact:?}"
+        );
         let mut far = Scene::<4>::new();
         far.push(Obstacle::sphere([2.0, 2.0, 2.0], 0.1).unwrap()).unwrap();
         assert_eq!(check_state(&far, &READY, &CheckConfig::default()), Ok(None));
@@ -322,7 +388,9 @@ mod tests {
     fn the_fixed_base_is_not_checked_against_obstacles() {
         // A table top flush with link0's footprint touches only the fixed base.
         let mut scene = Scene::<4>::new();
-        scene.push(Obstacle::cuboid([0.0, 0.0, -0.01], [0.3, 0.3, 0.02], ID).unwrap()).unwrap();
+        scene
+            .push(Obstacle::cuboid([0.0, 0.0, -0.01], [0.3, 0.3, 0.02], ID).unwrap())
+            .unwrap();
         assert_eq!(check_state(&scene, &READY, &CheckConfig::default()), Ok(None));
     }
 
@@ -332,7 +400,9 @@ mod tests {
         let a = [-1.2, -0.3, 0.0, -2.0, 0.0, 1.8, 0.785];
         let b = [1.2, -0.3, 0.0, -2.0, 0.0, 1.8, 0.785];
         let mut scene = Scene::<4>::new();
-        scene.push(Obstacle::cuboid([0.6, 0.0, 0.5], [0.4, 0.005, 0.4], ID).unwrap()).unwrap();
+        scene
+            .push(Obstacle::cuboid([0.6, 0.0, 0.5], [0.4, 0.005, 0.4], ID).unwrap())
+            .unwrap();
         let cfg = CheckConfig::default();
         assert_eq!(check_state(&scene, &a, &cfg), Ok(None));
         assert_eq!(check_state(&scene, &b, &cfg), Ok(None));
@@ -353,10 +423,16 @@ mod tests {
     #[test]
     fn bad_settings_and_huge_segments_are_errors() {
         let scene = Scene::<1>::new();
-        let cfg = CheckConfig { margin: -1.0, ..CheckConfig::default() };
+        let cfg = CheckConfig {
+            margin: -1.0,
+            ..CheckConfig::default()
+        };
         assert_eq!(check_state(&scene, &READY, &cfg), Err(Error::BadParameter));
         let mut far = READY;
         far[0] = 100.0;
-        assert_eq!(check_trajectory(&scene, &[READY, far], &CheckConfig::default(), true), Err(Error::SegmentTooLong));
+        assert_eq!(
+            check_trajectory(&scene, &[READY, far], &CheckConfig::default(), true),
+            Err(Error::SegmentTooLong)
+        );
     }
 }

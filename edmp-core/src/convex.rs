@@ -53,17 +53,29 @@ pub struct Primitive {
 impl Primitive {
     /// An obstacle as it stands in the world.
     pub fn obstacle(o: &Obstacle) -> Self {
-        Self { shape: o.shape, rotation: o.rotation, center: o.center }
+        Self {
+            shape: o.shape,
+            rotation: o.rotation,
+            center: o.center,
+        }
     }
 
     /// An object given in a frame (the held object in the hand), placed by that frame's pose.
     pub fn attached(o: &Obstacle, frame: &Pose<f32>) -> Self {
-        Self { shape: o.shape, rotation: frame.rotation * o.rotation, center: frame.transform_point(&o.center) }
+        Self {
+            shape: o.shape,
+            rotation: frame.rotation * o.rotation,
+            center: frame.transform_point(&o.center),
+        }
     }
 
     /// A box with half extents `half` at `pose` (a robot body's oriented box).
     pub fn cuboid(pose: &Pose<f32>, half: &Vector3<f32>) -> Self {
-        Self { shape: Shape::Cuboid { dims: half * 2.0 }, rotation: pose.rotation, center: pose.translation }
+        Self {
+            shape: Shape::Cuboid { dims: half * 2.0 },
+            rotation: pose.rotation,
+            center: pose.translation,
+        }
     }
 
     /// Radius of a ball around `center` that holds the primitive.
@@ -89,11 +101,19 @@ impl Convex for Primitive {
             }
             Shape::Sphere { radius } => {
                 let n = libm::sqrtf(local.norm_squared());
-                if n > 0.0 { local * (radius / n) } else { Vector3::new(radius, 0.0, 0.0) }
+                if n > 0.0 {
+                    local * (radius / n)
+                } else {
+                    Vector3::new(radius, 0.0, 0.0)
+                }
             }
             Shape::Cylinder { radius, height } => {
                 let n = libm::sqrtf(local.x * local.x + local.y * local.y);
-                let (x, y) = if n > 0.0 { (local.x * radius / n, local.y * radius / n) } else { (radius, 0.0) };
+                let (x, y) = if n > 0.0 {
+                    (local.x * radius / n, local.y * radius / n)
+                } else {
+                    (radius, 0.0)
+                };
                 Vector3::new(x, y, sign(local.z) * 0.5 * height)
             }
         };

@@ -78,7 +78,11 @@ pub fn distance_lower_bound<A: Convex, B: Convex>(a: &A, b: &B) -> f32 {
         None => 0.0,
         Some(v) => {
             let len = libm::sqrtf(v.norm_squared());
-            if len > 0.0 { gap_along(a, b, &(v / len)).max(0.0) } else { 0.0 }
+            if len > 0.0 {
+                gap_along(a, b, &(v / len)).max(0.0)
+            } else {
+                0.0
+            }
         }
     }
 }
@@ -94,7 +98,10 @@ impl Kept {
     fn of(indices: &[u8]) -> Self {
         let mut index = [0; 4];
         index[..indices.len()].copy_from_slice(indices);
-        Self { index, len: indices.len() }
+        Self {
+            index,
+            len: indices.len(),
+        }
     }
 }
 
@@ -161,7 +168,11 @@ fn nearest_on_triangle(s: &[V], [i, j, k]: [u8; 3]) -> (V, Kept) {
     let sum = va + vb + vc;
     if !(sum > 0.0) || !sum.is_finite() {
         // Degenerate (flat) triangle: fall back to its best edge.
-        return best_of([nearest_on_segment(s, [i, j]), nearest_on_segment(s, [i, k]), nearest_on_segment(s, [j, k])]);
+        return best_of([
+            nearest_on_segment(s, [i, j]),
+            nearest_on_segment(s, [i, k]),
+            nearest_on_segment(s, [j, k]),
+        ]);
     }
     let (v, w) = (vb / sum, vc / sum);
     (a + ab * v + ac * w, Kept::of(&[i, j, k]))
@@ -182,7 +193,12 @@ fn nearest_on_tetrahedron(s: &[V]) -> (V, Kept) {
     let mut best: Option<(V, Kept)> = None;
     let mut inside = true;
     for [i, j, k, opposite] in faces {
-        let (a, b, c, d) = (s[usize::from(i)], s[usize::from(j)], s[usize::from(k)], s[usize::from(opposite)]);
+        let (a, b, c, d) = (
+            s[usize::from(i)],
+            s[usize::from(j)],
+            s[usize::from(k)],
+            s[usize::from(opposite)],
+        );
         let normal = (b - a).cross(&(c - a));
         let origin_side = (-a).dot(&normal);
         let other_side = (d - a).dot(&normal);
@@ -222,7 +238,10 @@ mod tests {
     #[test]
     fn rotated_boxes() {
         let h = core::f32::consts::FRAC_1_SQRT_2;
-        let (w, z) = (libm::cosf(core::f32::consts::PI / 8.0), libm::sinf(core::f32::consts::PI / 8.0));
+        let (w, z) = (
+            libm::cosf(core::f32::consts::PI / 8.0),
+            libm::sinf(core::f32::consts::PI / 8.0),
+        );
         // A unit cube turned 45° about z reaches sqrt(0.5) along x.
         let a = Primitive::obstacle(&Obstacle::cuboid([0.0; 3], [1.0; 3], [w, 0.0, 0.0, z]).unwrap());
         let b = Primitive::obstacle(&Obstacle::cuboid([1.5, 0.0, 0.0], [1.0; 3], ID).unwrap());

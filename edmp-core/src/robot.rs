@@ -173,7 +173,11 @@ mod tests {
             let b = &PANDA_F64.bodies[body];
             for p in hull {
                 let local = b.rotation.transpose() * (p - b.center);
-                assert!((0..3).all(|k| local[k].abs() <= b.half_extents[k] + 1e-9), "{}", BODY_NAMES[body]);
+                assert!(
+                    (0..3).all(|k| local[k].abs() <= b.half_extents[k] + 1e-9),
+                    "{}",
+                    BODY_NAMES[body]
+                );
             }
         }
         assert_eq!(FRAME_NAMES[TCP_FRAME], "panda_grasptarget");

@@ -1,0 +1,152 @@
+//! The exact checker against PyBullet 3.2.7 (`tests/fixtures/collision_pybullet.json`):
+//! never "free" where PyBullet finds contact; the opposite error is measured and bounded.
+
+use edmp_core::checker::{CheckConfig, DEFAULT_MARGIN, check_state, clearance};
+use edmp_core::scene::{Obstacle, Scene};
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+struct Fixture {
+    format: String,
+    source: String,
+    obstacle_pairs: Vec<ObstaclePair>,
+    self_pairs: Vec<SelfPair>,
+}
+
+#[derive(Debug, Deserialize)]
+struct ObstaclePair {
+    joints: [f64; 7],
+    obstacle: ObstacleJson,
+    distance: f64,
+    link: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+struct SelfPair {
+    joints: [f64; 7],
+    distance: f64,
+    pair: Option<[String; 2]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+enum ObstacleJson {
+    Cuboid {
+        center: [f32; 3],
+        dims: [f32; 3],
+        quaternion: [f32; 4],
+    },
+    Cylinder {
+        center: [f32; 3],
+        radius: f32,
+        height: f32,
+        quaternion: [f32; 4],
+    },
+    Sphere {
+        center: [f32; 3],
+        radius: f32,
+    },
+}
+
+impl ObstacleJson {
+    fn build(&self) -> Obstacle {
+        match *self {
+            Self::Cuboid {
+                center,
+                dims,
+                quaternion,
+            } => Obstacle::cuboid(center, dims, quaternion),
+            Self::Cylinder {
+                center,
+                radius,
+                height,
+                quaternion,
+            } => Obstacle::cylinder(center, radius, height, quaternion),
+            Self::Sphere { center, radius } => Obstacle::sphere(center, radius),
+        }
+        .expect("fixture obstacles are valid")
+    }
+}
+
+fn fixture() -> Fixture {
+    serde_json::from_str(include_str!("../fixtures/collision_pybullet.json")).expect("fixture parses")
+}
+
+fn q32(q: &[f64; 7]) -> [f32; 7] {
+    q.map(|x| x as f32)
+}
+
+#[test]
+fn obstacle_contacts_are_never_missed() {
+    let f = fixture();
+    assert_eq!(f.format, "edmp-collision-fixture/1");
+    let contacts = f.obstacle_pairs.iter().filter(|p| p.distance <= 0.0).count();
+    assert!(f.obstacle_pairs.len() >= 2000 && contacts >= 900, "{}", f.source);
+    let cfg = CheckConfig {
+        self_collision: false,
+        ..CheckConfig::default()
+    };
+    let (mut false_contact, mut false_contact_beyond_1cm, mut worst_hidden) = (0, 0, 0.0f32);
+    for (i, pair) in f.obstacle_pairs.iter().enumerate() {
+        let mut scene = Scene::<1>::new();
+        scene.push(pair.obstacle.build()).unwrap();
+        let q = q32(&pair.joints);
+        let ours = check_state(&scene, &q, &cfg).unwrap();
+        if pair.distance <= 0.0 {
+            assert!(
+                ours.is_some(),
+                "pair {i}: PyBullet finds contact ({} m, {:?}), the checker says free",
+                pair.distance,
+                pair.link
+            );
+            // How far apart our hulls look where PyBullet touches: what the margin must cover.
+            worst_hidden = worst_hidden.max(clearance(&scene, &q).unwrap());
+        } else if ours.is_some() {
+            false_contact += 1;
+            if pair.distance > 0.01 {
+                false_contact_beyond_1cm += 1;
+            }
+        }
+    }
+    let free = f.obstacle_pairs.len() - contacts;
+    println!(
+        "obstacle pairs: {contacts} contact, {free} free; false contact {false_contact} ({:.2}% of free), \
+         {false_contact_beyond_1cm} of them farther than 1 cm; largest hull gap where PyBullet touches {worst_hidden:e} m \
+         (margin {DEFAULT_MARGIN} m)",
+        100.0 * false_contact as f64 / free as f64
+    );
+    assert!(worst_hidden < DEFAULT_MARGIN, "the margin no longer covers PyBullet's");
+    // Conservative by design, but not blind: the hull-exact checker should rarely cry wolf.
+    assert!(false_contact * 20 <= free, "false contacts: {false_contact} of {free}");
+}
+
+#[test]
+fn self_contacts_are_never_missed() {
+    let f = fixture();
+    let contacts = f.self_pairs.iter().filter(|p| p.distance <= 0.0).count();
+    assert!(f.self_pairs.len() >= 1000 && contacts >= 100);
+    let scene = Scene::<1>::new();
+    let mut false_contact = 0;
+    for (i, s) in f.self_pairs.iter().enumerate() {
+        let ours = check_state(&scene, &q32(&s.joints), &CheckConfig::default()).unwrap();
+        if s.distance <= 0.0 {
+            assert!(
+                ours.is_some(),
+                "config {i}: PyBullet finds self-contact {:?} ({} m), the checker says free",
+                s.pair,
+                s.distance
+            );
+        } else if ours.is_some() {
+            false_contact += 1;
+        }
+    }
+    let free = f.self_pairs.len() - contacts;
+    println!(
+        "self: {contacts} in contact, {free} free; false contact {false_contact} ({:.2}% of free)",
+        100.0 * false_contact as f64 / free as f64
+    );
+    assert!(
+        false_contact * 10 <= free,
+        "false self-contacts: {false_contact} of {free}"
+    );
+}
