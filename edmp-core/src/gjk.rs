@@ -166,7 +166,7 @@ fn nearest_on_triangle(s: &[V], [i, j, k]: [u8; 3]) -> (V, Kept) {
         return (b + (c - b) * t, Kept::of(&[j, k]));
     }
     let sum = va + vb + vc;
-    if !(sum > 0.0) || !sum.is_finite() {
+    if sum.is_nan() || sum <= 0.0 || !sum.is_finite() {
         // Degenerate (flat) triangle: fall back to its best edge.
         return best_of([
             nearest_on_segment(s, [i, j]),
