@@ -166,18 +166,13 @@ mod tests {
             assert!(r.determinant() > 0.0);
             assert!(b.half_extents.iter().all(|&h| h > 0.0));
         }
-        for body in 0..BODIES {
+        for (body, (b, name)) in PANDA_F64.bodies.iter().zip(BODY_NAMES).enumerate() {
             let hull = PANDA_F64.hull(body);
-            assert!(hull.len() >= 4, "{}", BODY_NAMES[body]);
+            assert!(hull.len() >= 4, "{name}");
             // Every vertex lies in the body's box (the box was fitted to them).
-            let b = &PANDA_F64.bodies[body];
             for p in hull {
                 let local = b.rotation.transpose() * (p - b.center);
-                assert!(
-                    (0..3).all(|k| local[k].abs() <= b.half_extents[k] + 1e-9),
-                    "{}",
-                    BODY_NAMES[body]
-                );
+                assert!((0..3).all(|k| local[k].abs() <= b.half_extents[k] + 1e-9), "{name}");
             }
         }
         assert_eq!(FRAME_NAMES[TCP_FRAME], "panda_grasptarget");
