@@ -71,6 +71,97 @@ pub fn distinct(points: &[Vec3]) -> Vec<Vec3> {
     out
 }
 
+/// The vertices of the convex hull of `points`, in their original order: the rest lie inside
+/// (or on a face, within 1e-12 m of its plane) and cannot change the hull, so the checker's
+/// support function can skip them. Incremental construction in f64 (build time only).
+pub fn hull_vertices(points: &[Vec3]) -> Vec<Vec3> {
+    let faces = convex_hull(points);
+    if faces.is_empty() {
+        return points.to_vec();
+    }
+    let mut keep = vec![false; points.len()];
+    for f in &faces {
+        for &i in f {
+            keep[i] = true;
+        }
+    }
+    points.iter().zip(keep).filter(|(_, k)| *k).map(|(p, _)| *p).collect()
+}
+
+const HULL_EPS: f64 = 1e-12;
+
+fn sub(a: &Vec3, b: &Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn dot(a: &Vec3, b: &Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Signed distance-like height of `p` above the plane of face `f` (outward positive).
+fn height(points: &[Vec3], f: &[usize; 3], p: &Vec3) -> f64 {
+    let n = cross(&sub(&points[f[1]], &points[f[0]]), &sub(&points[f[2]], &points[f[0]]));
+    let len = math::norm(&n);
+    if len == 0.0 { 0.0 } else { dot(&n, &sub(p, &points[f[0]])) / len }
+}
+
+/// Triangles (outward, counter-clockwise) of the hull; empty if the points are degenerate.
+pub fn convex_hull(points: &[Vec3]) -> Vec<[usize; 3]> {
+    if points.len() < 4 {
+        return Vec::new();
+    }
+    // Initial tetrahedron from extreme points.
+    let i0 = (0..points.len()).min_by(|&a, &b| points[a][0].total_cmp(&points[b][0])).unwrap_or(0);
+    let far = |from: &dyn Fn(usize) -> f64| (0..points.len()).max_by(|&a, &b| from(a).total_cmp(&from(b))).unwrap_or(0);
+    let i1 = far(&|i| math::norm(&sub(&points[i], &points[i0])));
+    let line = sub(&points[i1], &points[i0]);
+    let i2 = far(&|i| math::norm(&cross(&line, &sub(&points[i], &points[i0]))));
+    let normal = cross(&line, &sub(&points[i2], &points[i0]));
+    let i3 = far(&|i| dot(&normal, &sub(&points[i], &points[i0])).abs());
+    if math::norm(&normal) == 0.0 || dot(&normal, &sub(&points[i3], &points[i0])).abs() < HULL_EPS {
+        return Vec::new();
+    }
+    let mut faces: Vec<[usize; 3]> = vec![[i0, i1, i2], [i0, i3, i1], [i1, i3, i2], [i2, i3, i0]];
+    // Orient outwards: the centroid of the tetrahedron must be below every face.
+    let c = [0, 1, 2].map(|k| (points[i0][k] + points[i1][k] + points[i2][k] + points[i3][k]) / 4.0);
+    for f in &mut faces {
+        if height(points, f, &c) > 0.0 {
+            f.swap(1, 2);
+        }
+    }
+    for (i, p) in points.iter().enumerate() {
+        if [i0, i1, i2, i3].contains(&i) {
+            continue;
+        }
+        let visible: Vec<bool> = faces.iter().map(|f| height(points, f, p) > HULL_EPS).collect();
+        if !visible.iter().any(|&v| v) {
+            continue;
+        }
+        // Horizon: edges of visible faces whose twin belongs to a face that stays.
+        let mut horizon = Vec::new();
+        for (f, _) in faces.iter().zip(&visible).filter(|(_, v)| **v) {
+            for e in 0..3 {
+                let (a, b) = (f[e], f[(e + 1) % 3]);
+                let twin_visible = faces
+                    .iter()
+                    .zip(&visible)
+                    .any(|(g, &v)| v && (0..3).any(|k| g[k] == b && g[(k + 1) % 3] == a));
+                if !twin_visible {
+                    horizon.push((a, b));
+                }
+            }
+        }
+        let mut kept: Vec<[usize; 3]> = faces.iter().zip(&visible).filter(|(_, v)| !**v).map(|(f, _)| *f).collect();
+        kept.extend(horizon.into_iter().map(|(a, b)| [a, b, i]));
+        faces = kept;
+    }
+    faces
+}
+
 /// The axis-aligned box of `points` (what the original EDMP uses).
 pub fn aabb(points: &[Vec3]) -> OrientedBox {
     box_with_axes(points, &math::IDENTITY)
@@ -239,6 +330,26 @@ mod tests {
         let b = tight_box(&pts);
         for i in 0..3 {
             assert!((b.rotation[i][i] - 1.0).abs() < 1e-9, "{b:?}");
+        }
+    }
+
+    #[test]
+    fn hull_drops_interior_points_only() {
+        let mut pts = cube_corners(&math::axis_angle(&[0.3, 0.4, 0.5], 0.7), [0.1, 0.2, 0.3], [0.5, 0.0, -0.2]);
+        let corners = pts.clone();
+        // Interior points and points on faces and edges.
+        pts.push([0.5, 0.0, -0.2]);
+        pts.push([0.5, 0.01, -0.19]);
+        pts.push([(corners[0][0] + corners[1][0]) / 2.0, (corners[0][1] + corners[1][1]) / 2.0, (corners[0][2] + corners[1][2]) / 2.0]);
+        let kept = hull_vertices(&pts);
+        assert_eq!(kept, corners);
+        // Every dropped point is inside every face of the hull.
+        let faces = convex_hull(&pts);
+        assert_eq!(faces.len(), 12);
+        for p in &pts {
+            for f in &faces {
+                assert!(height(&pts, f, p) <= 1e-9);
+            }
         }
     }
 

@@ -70,8 +70,8 @@ pub struct Body {
     pub tight: OrientedBox,
     /// The link-frame axis-aligned box (what the original EDMP uses), for comparison.
     pub aabb: OrientedBox,
-    /// The distinct mesh vertices in the link frame, in file order: their convex hull is
-    /// the body's exact collision geometry (PyBullet uses the same hull).
+    /// The mesh vertices that are vertices of its convex hull, in the link frame, in file
+    /// order: their hull is the body's exact collision geometry (PyBullet collides the same hull).
     pub points: Vec<Vec3>,
 }
 
@@ -221,7 +221,7 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
             vertex_count: points.len(),
             tight: mesh::tight_box(&points),
             aabb: mesh::aabb(&points),
-            points: mesh::distinct(&points),
+            points: mesh::hull_vertices(&mesh::distinct(&points)),
         });
     }
 

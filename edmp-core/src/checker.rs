@@ -175,22 +175,40 @@ impl Placed<'_> {
     }
 
     /// Body `b` (robot or held) proven apart from primitive `p`.
-    fn body_apart_from(&self, b: usize, p: &Primitive) -> bool {
+    fn body_apart_from(&self, b: usize, p: &Primitive, hint: &mut Vector3<f32>) -> bool {
         if b >= BODIES {
-            return self.held.as_ref().is_none_or(|h| apart(h, p, self.margin));
+            return self.held.as_ref().is_none_or(|h| apart(h, p, self.margin, hint));
         }
-        apart(&self.obb(b), p, self.margin) || apart(&self.hull(b), p, self.margin)
+        // The oriented box holds the hull: proving the box apart is enough, and cheap.
+        apart(&self.obb(b), p, self.margin, hint) || apart(&self.hull(b), p, self.margin, hint)
     }
 
     /// Bodies `a < b` proven apart.
-    fn bodies_apart(&self, a: usize, b: usize) -> bool {
+    fn bodies_apart(&self, a: usize, b: usize, hint: &mut Vector3<f32>) -> bool {
         if b >= BODIES {
             return match &self.held {
-                Some(h) => self.body_apart_from(a, h),
+                Some(h) => self.body_apart_from(a, h, hint),
                 None => true,
             };
         }
-        apart(&self.obb(a), &self.obb(b), self.margin) || apart(&self.hull(a), &self.hull(b), self.margin)
+        apart(&self.obb(a), &self.obb(b), self.margin, hint)
+            || apart(&self.hull(a), &self.hull(b), self.margin, hint)
+    }
+}
+
+/// Robot shapes per state: every collision body, then the held object.
+const SLOTS: usize = BODIES + 1;
+
+/// The separating direction last found for each pair, carried from one state of a trajectory
+/// to the next (zero: none yet).
+struct Hints<const N: usize> {
+    obstacle: [[Vector3<f32>; N]; SLOTS],
+    body: [[Vector3<f32>; SLOTS]; SLOTS],
+}
+
+impl<const N: usize> Hints<N> {
+    fn new() -> Self {
+        Self { obstacle: [[Vector3::zeros(); N]; SLOTS], body: [[Vector3::zeros(); SLOTS]; SLOTS] }
     }
 }
 
@@ -208,6 +226,7 @@ fn contact_at<const N: usize>(
     obstacles: &[Primitive],
     q: &Joints<f32>,
     config: &CheckConfig,
+    hints: &mut Hints<N>,
 ) -> Result<Option<Contact>, Error> {
     let k = forward(q)?;
     let margin = config.margin;
@@ -219,8 +238,8 @@ fn contact_at<const N: usize>(
     let bodies = if placed.held.is_some() { BODIES + 1 } else { BODIES };
     for b in (0..bodies).filter(|&b| moves(b)) {
         let ball = placed.ball(b);
-        for (i, o) in obstacles.iter().enumerate() {
-            if placed.balls_apart(ball, (o.center, o.bounding_radius())) || placed.body_apart_from(b, o) {
+        for ((i, o), hint) in obstacles.iter().enumerate().zip(hints.obstacle[b].iter_mut()) {
+            if placed.balls_apart(ball, (o.center, o.bounding_radius())) || placed.body_apart_from(b, o, hint) {
                 continue;
             }
             return Ok(Some(Contact::Obstacle {
@@ -237,7 +256,7 @@ fn contact_at<const N: usize>(
             if body_level(a).abs_diff(body_level(b)) <= 1 {
                 continue;
             }
-            if placed.balls_apart(placed.ball(a), placed.ball(b)) || placed.bodies_apart(a, b) {
+            if placed.balls_apart(placed.ball(a), placed.ball(b)) || placed.bodies_apart(a, b, &mut hints.body[a][b]) {
                 continue;
             }
             return Ok(Some(Contact::SelfContact {
@@ -258,7 +277,7 @@ pub fn check_state<const N: usize>(
 ) -> Result<Option<Contact>, Error> {
     validate(config)?;
     let obstacles = obstacle_primitives(scene);
-    contact_at(scene, &obstacles[..scene.obstacles().len()], q, config)
+    contact_at(scene, &obstacles[..scene.obstacles().len()], q, config, &mut Hints::new())
 }
 
 /// A certified lower bound on the distance from the moving robot bodies' hulls (and the held
@@ -295,6 +314,7 @@ pub fn check_trajectory<const H: usize, const N: usize>(
     validate(config)?;
     let obstacles = obstacle_primitives(scene);
     let obstacles = &obstacles[..scene.obstacles().len()];
+    let mut hints = Hints::new();
     let mut report = TrajectoryReport {
         states: 0,
         colliding_states: 0,
@@ -312,7 +332,7 @@ pub fn check_trajectory<const H: usize, const N: usize>(
                 None => *q,
             };
             report.states += 1;
-            if let Some(contact) = contact_at(scene, obstacles, &state, config)? {
+            if let Some(contact) = contact_at(scene, obstacles, &state, config, &mut hints)? {
                 report.colliding_states += 1;
                 if report.first_contact.is_none() {
                     report.first_contact = Some(StateContact {

@@ -21,10 +21,12 @@ fn support<A: Convex, B: Convex>(a: &A, b: &B, d: &V) -> V {
 
 /// A vector `v = a − b` of the Minkowski difference near its point closest to the origin
 /// (`|v|` is an upper bound on the distance), or `None` when the origin lies inside the
-/// simplex built so far (the sets overlap or touch).
-pub fn closest<A: Convex, B: Convex>(a: &A, b: &B) -> Option<V> {
+/// simplex built so far (the sets overlap or touch). `start` is a first guess of the
+/// direction from `b` to `a` (any non-zero vector; a good one saves iterations).
+pub fn closest<A: Convex, B: Convex>(a: &A, b: &B, start: &V) -> Option<V> {
     let mut simplex = [V::zeros(); 4];
-    let mut v = support(a, b, &V::x());
+    let first = if start.norm_squared() > 0.0 && start.iter().all(|x| x.is_finite()) { *start } else { V::x() };
+    let mut v = support(a, b, &-first);
     simplex[0] = v;
     let mut n = 1;
     for _ in 0..MAX_ITERATIONS {
@@ -62,19 +64,32 @@ pub fn gap_along<A: Convex, B: Convex>(a: &A, b: &B, n: &V) -> f32 {
 }
 
 /// Whether `a` and `b` are proven to be more than `margin` apart.
-pub fn apart<A: Convex, B: Convex>(a: &A, b: &B, margin: f32) -> bool {
-    match closest(a, b) {
+///
+/// `hint` carries a separating direction from one call to the next (from `b` towards `a`;
+/// zero for none): consecutive states of a trajectory are usually separated along the same
+/// direction, and checking it costs two support evaluations instead of a GJK run. It is
+/// updated with the direction GJK finds.
+pub fn apart<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> bool {
+    let len = libm::sqrtf(hint.norm_squared());
+    if len > 0.0 && gap_along(a, b, &(*hint / len)) > margin {
+        return true;
+    }
+    match closest(a, b, hint) {
         None => false,
         Some(v) => {
             let len = libm::sqrtf(v.norm_squared());
-            len > 0.0 && gap_along(a, b, &(v / len)) > margin
+            if !(len > 0.0 && len.is_finite()) {
+                return false;
+            }
+            *hint = v;
+            gap_along(a, b, &(v / len)) > margin
         }
     }
 }
 
 /// A certified lower bound on the distance between `a` and `b` (zero when they may touch).
 pub fn distance_lower_bound<A: Convex, B: Convex>(a: &A, b: &B) -> f32 {
-    match closest(a, b) {
+    match closest(a, b, &V::x()) {
         None => 0.0,
         Some(v) => {
             let len = libm::sqrtf(v.norm_squared());
@@ -230,9 +245,13 @@ mod tests {
         let a = Primitive::obstacle(&Obstacle::sphere([0.0; 3], 0.5).unwrap());
         let b = Primitive::obstacle(&Obstacle::sphere([2.0, 0.0, 0.0], 0.25).unwrap());
         assert!((distance_lower_bound(&a, &b) - 1.25).abs() < 1e-5);
-        assert!(apart(&a, &b, 1.2) && !apart(&a, &b, 1.3));
+        assert!(apart(&a, &b, 1.2, &mut V::zeros()) && !apart(&a, &b, 1.3, &mut V::zeros()));
         let c = Primitive::obstacle(&Obstacle::sphere([0.6, 0.0, 0.0], 0.25).unwrap());
-        assert!(!apart(&a, &c, 0.0));
+        assert!(!apart(&a, &c, 0.0, &mut V::zeros()));
+        // A good hint is kept; a wrong one is replaced by what GJK finds.
+        let mut hint = V::new(-1.0, 0.0, 0.0);
+        assert!(apart(&b, &a, 1.2, &mut hint));
+        assert!(hint.x > 0.0 && hint.y.abs() < 1e-3, "{hint}");
     }
 
     #[test]
@@ -248,7 +267,7 @@ mod tests {
         let d = distance_lower_bound(&a, &b);
         assert!((d - (1.0 - h)).abs() < 1e-4, "{d}");
         let c = Primitive::obstacle(&Obstacle::cuboid([1.2, 0.0, 0.0], [1.0; 3], ID).unwrap());
-        assert!(!apart(&a, &c, 0.0));
+        assert!(!apart(&a, &c, 0.0, &mut V::zeros()));
     }
 
     #[test]

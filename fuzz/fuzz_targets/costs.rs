@@ -1,0 +1,110 @@
+//! Arbitrary scenes, trajectories and cost settings (raw f32 bits: NaN, infinities, huge and
+//! tiny values). The costs must return a finite, non-negative value with a finite gradient or a
+//! typed error that matches the input; the exact checker must answer or refuse, never panic.
+#![no_main]
+
+use edmp_core::Error;
+use edmp_core::checker::{CheckConfig, check_state, check_trajectory};
+use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
+use edmp_core::geometry::{CylinderBox, Inflation};
+use edmp_core::scene::{Obstacle, Scene, SceneError};
+use libfuzzer_sys::fuzz_target;
+
+const H: usize = 8;
+
+struct Reader<'a>(&'a [u8]);
+
+impl Reader<'_> {
+    fn byte(&mut self) -> u8 {
+        let (&b, rest) = self.0.split_first().unwrap_or((&0, &[]));
+        self.0 = rest;
+        b
+    }
+    fn f32(&mut self) -> f32 {
+        f32::from_le_bytes([self.byte(), self.byte(), self.byte(), self.byte()])
+    }
+    fn array<const M: usize>(&mut self) -> [f32; M] {
+        core::array::from_fn(|_| self.f32())
+    }
+}
+
+/// Builds an obstacle, retrying with a normalised quaternion so valid shapes are common.
+fn obstacle(kind: u8, center: [f32; 3], size: [f32; 3], quat: [f32; 4]) -> Result<Obstacle, SceneError> {
+    let build = |q: [f32; 4]| match kind % 3 {
+        0 => Obstacle::cuboid(center, size, q),
+        1 => Obstacle::cylinder(center, size[0], size[1], q),
+        _ => Obstacle::sphere(center, size[0]),
+    };
+    match build(quat) {
+        Err(SceneError::QuaternionNorm) => {
+            let n = quat.iter().map(|v| v * v).sum::<f32>().sqrt();
+            if n.is_finite() && n > 1e-3 { build(quat.map(|v| v / n)) } else { Err(SceneError::QuaternionNorm) }
+        }
+        other => other,
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let mut r = Reader(data);
+    let count = r.byte() % 9;
+    let flags = r.byte();
+    let mut scene = Scene::<8>::new();
+    for _ in 0..count {
+        let kind = r.byte();
+        let (center, size, quat) = (r.array::<3>(), r.array::<3>(), r.array::<4>());
+        if let Ok(o) = obstacle(kind, center, size, quat) {
+            assert!(o.center.iter().chain(o.rotation.iter()).all(|x| x.is_finite()));
+            scene.push(o).expect("capacity 8 holds at most 8");
+        }
+    }
+    if flags & 4 != 0 {
+        let kind = r.byte();
+        let (center, size, quat) = (r.array::<3>(), r.array::<3>(), r.array::<4>());
+        if let Ok(o) = obstacle(kind, center, size, quat) {
+            scene.hold(o);
+        }
+    }
+    let inflation = Inflation { clearance: r.f32(), expansion: r.f32() };
+    let trajectory: [[f32; 7]; H] = core::array::from_fn(|_| r.array::<7>());
+    let kind = if flags & 1 == 0 { CostKind::Intersection } else { CostKind::Swept };
+    let cylinder = if flags & 2 == 0 { CylinderBox::Enclosing } else { CylinderBox::OriginalEdmp };
+    let config = CostConfig { kind, inflation, cylinder };
+
+    let joints_finite = trajectory.iter().flatten().all(|x| x.is_finite());
+    let params_ok = inflation.clearance.is_finite()
+        && inflation.expansion.is_finite()
+        && inflation.clearance >= 0.0
+        && inflation.expansion >= 0.0;
+    let mut gradient = [[0.0f32; 7]; H];
+    match trajectory_cost(&scene, &trajectory, &config, Some(&mut gradient)) {
+        Ok(cost) => {
+            assert!(joints_finite && params_ok);
+            assert!(cost.is_finite() && cost >= 0.0, "cost {cost}");
+            assert!(gradient.iter().flatten().all(|g| g.is_finite()), "{gradient:?}");
+        }
+        Err(Error::BadParameter) => assert!(!params_ok),
+        Err(Error::NonFiniteJoint { .. }) => assert!(params_ok && !joints_finite),
+        Err(Error::Overflow) | Err(Error::NonFiniteGradient) => assert!(params_ok && joints_finite),
+        Err(e) => panic!("unexpected cost error {e:?}"),
+    }
+
+    let check = CheckConfig { self_collision: flags & 8 == 0, ..CheckConfig::default() };
+    for q in trajectory.iter().take(2) {
+        match check_state(&scene, q, &check) {
+            Ok(_) => assert!(q.iter().all(|x| x.is_finite())),
+            Err(Error::NonFiniteJoint { .. }) => assert!(!q.iter().all(|x| x.is_finite())),
+            Err(e) => panic!("unexpected checker error {e:?}"),
+        }
+    }
+    let short: [[f32; 7]; 2] = [trajectory[0], trajectory[1]];
+    match check_trajectory(&scene, &short, &check, true) {
+        // Stopping at the first contact may end after one state; a free report saw both ends.
+        Ok(report) => {
+            assert!(report.states >= 1 && report.colliding_states <= report.states);
+            assert!(report.first_contact.is_some() || report.states >= 2);
+            assert_eq!(report.first_contact.is_some(), report.colliding_states > 0);
+        }
+        Err(Error::NonFiniteJoint { .. }) | Err(Error::SegmentTooLong) => {}
+        Err(e) => panic!("unexpected trajectory check error {e:?}"),
+    }
+});
