@@ -150,7 +150,11 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     wl(w, "            ],");
     wl(w, "            hull_points: [");
     for b in &chain.bodies {
-        let note = format!("the {} convex-hull vertices of `{}`, in its link frame", b.points.len(), b.mesh);
+        let note = format!(
+            "the {} convex-hull vertices of `{}`, in its link frame",
+            b.points.len(),
+            b.mesh
+        );
         wl(w, &format!("                // `{}`: {note}", b.name));
         for p in &b.points {
             wl(w, &format!("                {},", vec3(p)));

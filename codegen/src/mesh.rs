@@ -95,7 +95,11 @@ fn sub(a: &Vec3, b: &Vec3) -> Vec3 {
 }
 
 fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 fn dot(a: &Vec3, b: &Vec3) -> f64 {
@@ -106,7 +110,11 @@ fn dot(a: &Vec3, b: &Vec3) -> f64 {
 fn height(points: &[Vec3], f: &[usize; 3], p: &Vec3) -> f64 {
     let n = cross(&sub(&points[f[1]], &points[f[0]]), &sub(&points[f[2]], &points[f[0]]));
     let len = math::norm(&n);
-    if len == 0.0 { 0.0 } else { dot(&n, &sub(p, &points[f[0]])) / len }
+    if len == 0.0 {
+        0.0
+    } else {
+        dot(&n, &sub(p, &points[f[0]])) / len
+    }
 }
 
 /// Triangles (outward, counter-clockwise) of the hull; empty if the points are degenerate.
@@ -115,8 +123,14 @@ pub fn convex_hull(points: &[Vec3]) -> Vec<[usize; 3]> {
         return Vec::new();
     }
     // Initial tetrahedron from extreme points.
-    let i0 = (0..points.len()).min_by(|&a, &b| points[a][0].total_cmp(&points[b][0])).unwrap_or(0);
-    let far = |from: &dyn Fn(usize) -> f64| (0..points.len()).max_by(|&a, &b| from(a).total_cmp(&from(b))).unwrap_or(0);
+    let i0 = (0..points.len())
+        .min_by(|&a, &b| points[a][0].total_cmp(&points[b][0]))
+        .unwrap_or(0);
+    let far = |from: &dyn Fn(usize) -> f64| {
+        (0..points.len())
+            .max_by(|&a, &b| from(a).total_cmp(&from(b)))
+            .unwrap_or(0)
+    };
     let i1 = far(&|i| math::norm(&sub(&points[i], &points[i0])));
     let line = sub(&points[i1], &points[i0]);
     let i2 = far(&|i| math::norm(&cross(&line, &sub(&points[i], &points[i0]))));
@@ -155,7 +169,12 @@ pub fn convex_hull(points: &[Vec3]) -> Vec<[usize; 3]> {
                 }
             }
         }
-        let mut kept: Vec<[usize; 3]> = faces.iter().zip(&visible).filter(|(_, v)| !**v).map(|(f, _)| *f).collect();
+        let mut kept: Vec<[usize; 3]> = faces
+            .iter()
+            .zip(&visible)
+            .filter(|(_, v)| !**v)
+            .map(|(f, _)| *f)
+            .collect();
         kept.extend(horizon.into_iter().map(|(a, b)| [a, b, i]));
         faces = kept;
     }
@@ -335,12 +354,20 @@ mod tests {
 
     #[test]
     fn hull_drops_interior_points_only() {
-        let mut pts = cube_corners(&math::axis_angle(&[0.3, 0.4, 0.5], 0.7), [0.1, 0.2, 0.3], [0.5, 0.0, -0.2]);
+        let mut pts = cube_corners(
+            &math::axis_angle(&[0.3, 0.4, 0.5], 0.7),
+            [0.1, 0.2, 0.3],
+            [0.5, 0.0, -0.2],
+        );
         let corners = pts.clone();
         // Interior points and points on faces and edges.
         pts.push([0.5, 0.0, -0.2]);
         pts.push([0.5, 0.01, -0.19]);
-        pts.push([(corners[0][0] + corners[1][0]) / 2.0, (corners[0][1] + corners[1][1]) / 2.0, (corners[0][2] + corners[1][2]) / 2.0]);
+        pts.push([
+            (corners[0][0] + corners[1][0]) / 2.0,
+            (corners[0][1] + corners[1][1]) / 2.0,
+            (corners[0][2] + corners[1][2]) / 2.0,
+        ]);
         let kept = hull_vertices(&pts);
         assert_eq!(kept, corners);
         // Every dropped point is inside every face of the hull.

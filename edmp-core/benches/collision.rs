@@ -42,20 +42,29 @@ fn trajectory(rng: &mut Rng) -> [[f32; 7]; H] {
 /// 20 obstacles around the arm, none touching `path` (so the checker walks every state).
 fn scene(rng: &mut Rng, path: &[[f32; 7]; H]) -> Scene<64> {
     let mut scene = Scene::<64>::new();
-    scene.push(Obstacle::cuboid([0.5, 0.0, -0.02], [1.0, 1.2, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap()).unwrap();
+    scene
+        .push(Obstacle::cuboid([0.5, 0.0, -0.02], [1.0, 1.2, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())
+        .unwrap();
     while scene.obstacles().len() < 20 {
         let r = rng.range(0.3, 0.9);
         let phi = rng.range(-3.1, 3.1);
         let center = [r * phi.cos(), r * phi.sin(), rng.range(0.0, 0.9)];
         let o = match scene.obstacles().len() % 3 {
-            0 => Obstacle::cuboid(center, [rng.range(0.05, 0.3), rng.range(0.05, 0.3), rng.range(0.05, 0.3)], [1.0, 0.0, 0.0, 0.0]),
+            0 => Obstacle::cuboid(
+                center,
+                [rng.range(0.05, 0.3), rng.range(0.05, 0.3), rng.range(0.05, 0.3)],
+                [1.0, 0.0, 0.0, 0.0],
+            ),
             1 => Obstacle::cylinder(center, rng.range(0.03, 0.1), rng.range(0.1, 0.4), [1.0, 0.0, 0.0, 0.0]),
             _ => Obstacle::sphere(center, rng.range(0.03, 0.12)),
         }
         .unwrap();
         let mut trial = scene.clone();
         trial.push(o).unwrap();
-        if check_trajectory(&trial, path, &CheckConfig::default(), true).unwrap().is_free() {
+        if check_trajectory(&trial, path, &CheckConfig::default(), true)
+            .unwrap()
+            .is_free()
+        {
             scene = trial;
         }
     }
@@ -70,10 +79,16 @@ fn bench(c: &mut Criterion) {
     for (name, kind) in [("intersection", CostKind::Intersection), ("swept", CostKind::Swept)] {
         let config = CostConfig {
             kind,
-            inflation: Inflation { clearance: 0.05, expansion: 0.2 },
+            inflation: Inflation {
+                clearance: 0.05,
+                expansion: 0.2,
+            },
             cylinder: CylinderBox::Enclosing,
         };
-        let total: f32 = batch.iter().map(|t| trajectory_cost(&scene, t, &config, None).unwrap()).sum();
+        let total: f32 = batch
+            .iter()
+            .map(|t| trajectory_cost(&scene, t, &config, None).unwrap())
+            .sum();
         assert!(total > 0.0, "the bench scene must make the {name} cost work");
         group.bench_function(format!("{name} cost+gradient, 12x50 waypoints, 20 obstacles"), |b| {
             let mut grad = [[0.0f32; 7]; H];
@@ -88,9 +103,10 @@ fn bench(c: &mut Criterion) {
     }
     let report = check_trajectory(&scene, &batch[0], &CheckConfig::default(), false).unwrap();
     assert!(report.is_free());
-    group.bench_function(format!("exact check, 50 waypoints ({} states), 20 obstacles", report.states), |b| {
-        b.iter(|| check_trajectory(&scene, black_box(&batch[0]), &CheckConfig::default(), true))
-    });
+    group.bench_function(
+        format!("exact check, 50 waypoints ({} states), 20 obstacles", report.states),
+        |b| b.iter(|| check_trajectory(&scene, black_box(&batch[0]), &CheckConfig::default(), true)),
+    );
     group.finish();
 }
 

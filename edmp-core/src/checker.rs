@@ -146,23 +146,6 @@ struct Placed<'a> {
 }
 
 impl Placed<'_> {
-    /// Centre and radius of a ball around body `b` (its oriented box, or the held object).
-    fn ball(&self, b: usize) -> (Vector3<f32>, f32) {
-        match (b < BODIES, &self.held) {
-            (true, _) => (
-                self.k.boxes[b].translation,
-                libm::sqrtf(PANDA.bodies[b].half_extents.norm_squared()),
-            ),
-            (false, Some(h)) => (h.center, h.bounding_radius()),
-            (false, None) => (Vector3::zeros(), 0.0),
-        }
-    }
-
-    fn balls_apart(&self, (c1, r1): (Vector3<f32>, f32), (c2, r2): (Vector3<f32>, f32)) -> bool {
-        let reach = r1 + r2 + self.margin;
-        (c1 - c2).norm_squared() > reach * reach
-    }
-
     fn obb(&self, b: usize) -> Primitive {
         Primitive::cuboid(&self.k.boxes[b], &PANDA.bodies[b].half_extents)
     }
@@ -191,8 +174,7 @@ impl Placed<'_> {
                 None => true,
             };
         }
-        apart(&self.obb(a), &self.obb(b), self.margin, hint)
-            || apart(&self.hull(a), &self.hull(b), self.margin, hint)
+        apart(&self.obb(a), &self.obb(b), self.margin, hint) || apart(&self.hull(a), &self.hull(b), self.margin, hint)
     }
 }
 
@@ -208,7 +190,10 @@ struct Hints<const N: usize> {
 
 impl<const N: usize> Hints<N> {
     fn new() -> Self {
-        Self { obstacle: [[Vector3::zeros(); N]; SLOTS], body: [[Vector3::zeros(); SLOTS]; SLOTS] }
+        Self {
+            obstacle: [[Vector3::zeros(); N]; SLOTS],
+            body: [[Vector3::zeros(); SLOTS]; SLOTS],
+        }
     }
 }
 
@@ -217,55 +202,105 @@ fn validate(config: &CheckConfig) -> Result<(), Error> {
     if ok { Ok(()) } else { Err(Error::BadParameter) }
 }
 
-fn obstacle_primitives<const N: usize>(scene: &Scene<N>) -> [Primitive; N] {
-    core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Primitive::obstacle))
+const PAIRS: usize = SLOTS * SLOTS;
+
+/// What stays the same for every state of one check: the obstacles and their bounding balls,
+/// the robot shapes' ball radii, the self-collision pairs, and the separating directions
+/// remembered so far.
+struct Prepared<'s, const N: usize> {
+    scene: &'s Scene<N>,
+    config: CheckConfig,
+    obstacles: [Primitive; N],
+    obstacle_radius: [f32; N],
+    shapes: usize,
+    radius: [f32; SLOTS],
+    pairs: [(u8, u8); PAIRS],
+    pair_count: usize,
+    hints: Hints<N>,
 }
 
-fn contact_at<const N: usize>(
-    scene: &Scene<N>,
-    obstacles: &[Primitive],
-    q: &Joints<f32>,
-    config: &CheckConfig,
-    hints: &mut Hints<N>,
-) -> Result<Option<Contact>, Error> {
-    let k = forward(q)?;
-    let margin = config.margin;
-    let placed = Placed {
-        k: &k,
-        held: scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME])),
-        margin,
-    };
-    let bodies = if placed.held.is_some() { BODIES + 1 } else { BODIES };
-    for b in (0..bodies).filter(|&b| moves(b)) {
-        let ball = placed.ball(b);
-        for ((i, o), hint) in obstacles.iter().enumerate().zip(hints.obstacle[b].iter_mut()) {
-            if placed.balls_apart(ball, (o.center, o.bounding_radius())) || placed.body_apart_from(b, o, hint) {
-                continue;
+impl<'s, const N: usize> Prepared<'s, N> {
+    fn new(scene: &'s Scene<N>, config: &CheckConfig) -> Result<Self, Error> {
+        validate(config)?;
+        let obstacles: [Primitive; N] =
+            core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Primitive::obstacle));
+        let obstacle_radius = obstacles.map(|o| o.bounding_radius());
+        let shapes = if scene.held().is_some() { SLOTS } else { BODIES };
+        let radius = core::array::from_fn(|b| match (PANDA.bodies.get(b), scene.held()) {
+            (Some(body), _) => libm::sqrtf(body.half_extents.norm_squared()),
+            (None, Some(h)) => Primitive::obstacle(h).bounding_radius(),
+            (None, None) => 0.0,
+        });
+        let mut pairs = [(0u8, 0u8); PAIRS];
+        let mut pair_count = 0;
+        for a in 0..shapes {
+            for b in a + 1..shapes {
+                if body_level(a).abs_diff(body_level(b)) >= 2 {
+                    pairs[pair_count] = (a as u8, b as u8);
+                    pair_count += 1;
+                }
             }
-            return Ok(Some(Contact::Obstacle {
-                body: b as u8,
-                obstacle: i as u8,
-            }));
         }
+        Ok(Self {
+            scene,
+            config: *config,
+            obstacles,
+            obstacle_radius,
+            shapes,
+            radius,
+            pairs,
+            pair_count,
+            hints: Hints::new(),
+        })
     }
-    if !config.self_collision {
-        return Ok(None);
-    }
-    for a in 0..bodies {
-        for b in a + 1..bodies {
-            if body_level(a).abs_diff(body_level(b)) <= 1 {
-                continue;
+
+    /// The first contact at configuration `q`, if any.
+    fn contact_at(&mut self, q: &Joints<f32>) -> Result<Option<Contact>, Error> {
+        let k = forward(q)?;
+        let margin = self.config.margin;
+        let held = self.scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME]));
+        let center: [Vector3<f32>; SLOTS] = core::array::from_fn(|b| match (k.boxes.get(b), &held) {
+            (Some(pose), _) => pose.translation,
+            (None, Some(h)) => h.center,
+            (None, None) => Vector3::zeros(),
+        });
+        let near = |c1: &Vector3<f32>, r1: f32, c2: &Vector3<f32>, r2: f32| {
+            let reach = r1 + r2 + margin;
+            (c1 - c2).norm_squared() <= reach * reach
+        };
+        let placed = Placed { k: &k, held, margin };
+        let count = self.scene.obstacles().len();
+        for b in (0..self.shapes).filter(|&b| moves(b)) {
+            let candidates = self
+                .obstacles
+                .iter()
+                .zip(self.obstacle_radius.iter())
+                .zip(self.hints.obstacle[b].iter_mut());
+            for (i, ((o, &r), hint)) in candidates.take(count).enumerate() {
+                if near(&center[b], self.radius[b], &o.center, r) && !placed.body_apart_from(b, o, hint) {
+                    return Ok(Some(Contact::Obstacle {
+                        body: b as u8,
+                        obstacle: i as u8,
+                    }));
+                }
             }
-            if placed.balls_apart(placed.ball(a), placed.ball(b)) || placed.bodies_apart(a, b, &mut hints.body[a][b]) {
-                continue;
-            }
-            return Ok(Some(Contact::SelfContact {
-                first: a as u8,
-                second: b as u8,
-            }));
         }
+        if !self.config.self_collision {
+            return Ok(None);
+        }
+        for &(a, b) in &self.pairs[..self.pair_count] {
+            let (a, b) = (usize::from(a), usize::from(b));
+            if near(&center[a], self.radius[a], &center[b], self.radius[b])
+                && !placed.bodies_apart(a, b, &mut self.hints.body[a][b])
+            {
+                return Ok(Some(Contact::SelfContact {
+                    first: a as u8,
+                    second: b as u8,
+                }));
+            }
+        }
+        Ok(None)
     }
-    Ok(None)
 }
 
 /// Checks one configuration: the first contact found, or `None` when every pair is proven
@@ -275,9 +310,7 @@ pub fn check_state<const N: usize>(
     q: &Joints<f32>,
     config: &CheckConfig,
 ) -> Result<Option<Contact>, Error> {
-    validate(config)?;
-    let obstacles = obstacle_primitives(scene);
-    contact_at(scene, &obstacles[..scene.obstacles().len()], q, config, &mut Hints::new())
+    Prepared::new(scene, config)?.contact_at(q)
 }
 
 /// A certified lower bound on the distance from the moving robot bodies' hulls (and the held
@@ -311,10 +344,7 @@ pub fn check_trajectory<const H: usize, const N: usize>(
     config: &CheckConfig,
     stop_at_first: bool,
 ) -> Result<TrajectoryReport, Error> {
-    validate(config)?;
-    let obstacles = obstacle_primitives(scene);
-    let obstacles = &obstacles[..scene.obstacles().len()];
-    let mut hints = Hints::new();
+    let mut prepared = Prepared::new(scene, config)?;
     let mut report = TrajectoryReport {
         states: 0,
         colliding_states: 0,
@@ -332,7 +362,7 @@ pub fn check_trajectory<const H: usize, const N: usize>(
                 None => *q,
             };
             report.states += 1;
-            if let Some(contact) = contact_at(scene, obstacles, &state, config, &mut hints)? {
+            if let Some(contact) = prepared.contact_at(&state)? {
                 report.colliding_states += 1;
                 if report.first_contact.is_none() {
                     report.first_contact = Some(StateContact {

@@ -25,7 +25,11 @@ fn support<A: Convex, B: Convex>(a: &A, b: &B, d: &V) -> V {
 /// direction from `b` to `a` (any non-zero vector; a good one saves iterations).
 pub fn closest<A: Convex, B: Convex>(a: &A, b: &B, start: &V) -> Option<V> {
     let mut simplex = [V::zeros(); 4];
-    let first = if start.norm_squared() > 0.0 && start.iter().all(|x| x.is_finite()) { *start } else { V::x() };
+    let first = if start.norm_squared() > 0.0 && start.iter().all(|x| x.is_finite()) {
+        *start
+    } else {
+        V::x()
+    };
     let mut v = support(a, b, &-first);
     simplex[0] = v;
     let mut n = 1;
