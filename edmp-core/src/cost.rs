@@ -15,10 +15,10 @@
 
 use crate::error::Error;
 use crate::geometry::{Aabb, CylinderBox, Inflation, box_dims, obstacle_aabb};
-use crate::kinematics::{CORNERS, CornerGradient, Joints, Kinematics, forward};
+use crate::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward};
 use crate::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Obstacle, Scene};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 /// Which of EDMP's two costs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,6 +79,26 @@ fn aabb_of(corners: &[Vector3<f32>; CORNERS]) -> (Aabb, [[u8; 3]; 2]) {
     (b, arg)
 }
 
+/// World AABB of an oriented box, `centre ± |R|·half`, with the corners that set its bounds:
+/// along world axis `k` the highest corner takes `+half_j` exactly where `R[k][j] > 0`.
+fn box_aabb(pose: &Pose<f32>, half: &Vector3<f32>) -> (Aabb, [[u8; 3]; 2]) {
+    let r = &pose.rotation;
+    let reach = r.abs() * half;
+    let mut arg = [[0u8; 3]; 2];
+    for k in 0..3 {
+        let high = u8::from(r[(k, 0)] > 0.0) | u8::from(r[(k, 1)] > 0.0) << 1 | u8::from(r[(k, 2)] > 0.0) << 2;
+        arg[1][k] = high;
+        arg[0][k] = !high & 0b111;
+    }
+    (
+        Aabb {
+            min: pose.translation - reach,
+            max: pose.translation + reach,
+        },
+        arg,
+    )
+}
+
 /// Corners of the held object's box in the hand frame.
 fn held_local_corners(held: &Obstacle, cylinder: CylinderBox) -> [Vector3<f32>; CORNERS] {
     let h = box_dims(&held.shape, cylinder) * 0.5;
@@ -103,7 +123,7 @@ fn robot_boxes(k: &Kinematics<f32>, held: Option<&[Vector3<f32>; CORNERS]>) -> R
         if PANDA.bodies[b].frame == 0 {
             continue;
         }
-        (out.aabb[b], out.arg[b]) = aabb_of(&k.corners(b));
+        (out.aabb[b], out.arg[b]) = box_aabb(&k.boxes[b], &PANDA.bodies[b].half_extents);
         out.active[b] = true;
     }
     if let Some(local) = held {
@@ -118,7 +138,7 @@ fn robot_boxes(k: &Kinematics<f32>, held: Option<&[Vector3<f32>; CORNERS]>) -> R
 /// Intersection volume of `a` with `o` and its gradient with respect to `a`'s bounds.
 fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector3<f32>)> {
     let overlap = a.max.inf(&o.max) - a.min.sup(&o.min);
-    if overlap.iter().any(|&d| d <= 0.0) {
+    if overlap.x <= 0.0 || overlap.y <= 0.0 || overlap.z <= 0.0 {
         return None;
     }
     let volume = overlap.x * overlap.y * overlap.z;
@@ -132,9 +152,40 @@ fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector
 type BoundGradient = [[Vector3<f32>; 2]; SLOTS];
 const ZERO_BOUNDS: BoundGradient = [[Vector3::new(0.0, 0.0, 0.0); 2]; SLOTS];
 
+/// One waypoint on its way through the cost: its kinematics and boxes, and the gradient its
+/// boxes' bounds have collected so far (`touched` once anything was added).
+#[derive(Clone, Copy, Debug)]
+struct Waypoint {
+    k: Kinematics<f32>,
+    boxes: RobotBoxes,
+    union: Aabb,
+    bound: BoundGradient,
+    touched: bool,
+}
+
+impl Waypoint {
+    fn new(k: Kinematics<f32>, held: Option<&[Vector3<f32>; CORNERS]>) -> Self {
+        let boxes = robot_boxes(&k, held);
+        let mut union: Option<Aabb> = None;
+        for (b, _) in boxes.aabb.iter().zip(boxes.active.iter()).filter(|(_, a)| **a) {
+            union = Some(union.map_or(*b, |u| u.union(b)));
+        }
+        Self {
+            k,
+            boxes,
+            union: union.unwrap_or(EMPTY),
+            bound: ZERO_BOUNDS,
+            touched: false,
+        }
+    }
+}
+
 /// EDMP's cost of one trajectory of `H` waypoints in `scene`. With `gradient`, also writes
 /// `∂cost/∂waypoint` for every waypoint (iv: zero at the two ends; sv: the ends get theirs too,
 /// the caller decides whether to apply them).
+///
+/// One streaming pass: each waypoint's FK runs once, and its gradient is finished as soon as
+/// the last segment that touches it has been costed, so memory does not grow with `H`.
 pub fn trajectory_cost<const H: usize, const N: usize>(
     scene: &Scene<N>,
     trajectory: &[Joints<f32>; H],
@@ -152,85 +203,97 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     let obstacles = &obstacles[..scene.obstacles().len()];
     let held = scene.held().map(|h| held_local_corners(h, config.cylinder));
 
-    let mut boxes = [RobotBoxes {
-        aabb: [EMPTY; SLOTS],
-        arg: [[[0; 3]; 2]; SLOTS],
-        active: [false; SLOTS],
-    }; H];
-    for (b, q) in boxes.iter_mut().zip(trajectory.iter()) {
-        *b = robot_boxes(&forward(q)?, held.as_ref());
+    let mut gradient = gradient;
+    let mut total = 0.0f32;
+    let mut previous: Option<Waypoint> = None;
+    for (w, q) in trajectory.iter().enumerate() {
+        let mut current = Waypoint::new(forward(q)?, held.as_ref());
+        match (config.kind, previous.as_mut()) {
+            (CostKind::Intersection, _) if w > 0 && w + 1 < H => total += intersection(&mut current, obstacles),
+            (CostKind::Swept, Some(before)) => total += swept(before, &mut current, obstacles),
+            _ => {}
+        }
+        if let Some(done) = previous.replace(current) {
+            finish(&done, w - 1, gradient.as_deref_mut(), held.as_ref())?;
+        }
     }
-
-    let mut bounds = [ZERO_BOUNDS; H];
-    let total = match config.kind {
-        CostKind::Intersection => intersection(&boxes, obstacles, &mut bounds),
-        CostKind::Swept => swept(&boxes, obstacles, &mut bounds),
-    };
-    let bounds_finite = bounds
-        .iter()
-        .flatten()
-        .flatten()
-        .all(|v| v.iter().all(|x| x.is_finite()));
-    if !total.is_finite() || !bounds_finite {
-        return Err(Error::Overflow);
+    if let Some(done) = previous {
+        finish(&done, H - 1, gradient, held.as_ref())?;
     }
-
-    let Some(gradient) = gradient else { return Ok(total) };
-    for ((g, q), (b, bound)) in gradient
-        .iter_mut()
-        .zip(trajectory.iter())
-        .zip(boxes.iter().zip(bounds.iter()))
-    {
-        *g = if bound.iter().flatten().all(|v| v.iter().all(|&x| x == 0.0)) {
-            [0.0; JOINTS]
-        } else {
-            waypoint_gradient(&forward(q)?, b, bound, held.as_ref())?
-        };
+    if total.is_finite() {
+        Ok(total)
+    } else {
+        Err(Error::Overflow)
     }
-    Ok(total)
 }
 
-/// Intersection volume over the interior waypoints; adds its gradient to `bounds`.
-fn intersection<const H: usize>(boxes: &[RobotBoxes; H], obstacles: &[Aabb], bounds: &mut [BoundGradient; H]) -> f32 {
+/// Writes waypoint `w`'s joint gradient once its bounds are final.
+fn finish<const H: usize>(
+    done: &Waypoint,
+    w: usize,
+    gradient: Option<&mut [Joints<f32>; H]>,
+    held: Option<&[Vector3<f32>; CORNERS]>,
+) -> Result<(), Error> {
+    let Some(slot) = gradient.and_then(|g| g.get_mut(w)) else {
+        return Ok(());
+    };
+    *slot = if done.touched {
+        // Finite inputs whose volumes' gradients overflowed are an overflow, not bad input.
+        waypoint_gradient(done, held).map_err(|e| match e {
+            Error::NonFiniteGradient => Error::Overflow,
+            other => other,
+        })?
+    } else {
+        [0.0; JOINTS]
+    };
+    Ok(())
+}
+
+/// Whether two boxes overlap with positive volume.
+fn overlaps(a: &Aabb, b: &Aabb) -> bool {
+    let (lo, hi) = (a.min.sup(&b.min), a.max.inf(&b.max));
+    hi.x > lo.x && hi.y > lo.y && hi.z > lo.z
+}
+
+/// Intersection volume of one interior waypoint's boxes; adds its gradient to the waypoint.
+fn intersection(w: &mut Waypoint, obstacles: &[Aabb]) -> f32 {
     let mut total = 0.0;
-    let interior = boxes.iter().zip(bounds.iter_mut()).take(H.saturating_sub(1)).skip(1);
-    for (robot, bound) in interior {
-        for ((aabb, &active), slot) in robot.aabb.iter().zip(robot.active.iter()).zip(bound.iter_mut()) {
-            if !active {
+    for o in obstacles.iter().filter(|o| overlaps(&w.union, o)) {
+        for s in 0..SLOTS {
+            if !w.boxes.active[s] {
                 continue;
             }
-            for o in obstacles {
-                if let Some((v, d_min, d_max)) = volume_with_gradient(aabb, o) {
-                    total += v;
-                    slot[0] += d_min;
-                    slot[1] += d_max;
-                }
+            if let Some((v, d_min, d_max)) = volume_with_gradient(&w.boxes.aabb[s], o) {
+                total += v;
+                w.bound[s][0] += d_min;
+                w.bound[s][1] += d_max;
+                w.touched = true;
             }
         }
     }
     total
 }
 
-/// Swept volume over the segments; adds its gradient to `bounds`, each swept bound's share
-/// going to the segment end that set it (ties to the first end).
-fn swept<const H: usize>(boxes: &[RobotBoxes; H], obstacles: &[Aabb], bounds: &mut [BoundGradient; H]) -> f32 {
+/// Swept volume of the segment between two waypoints; each swept bound's share of the
+/// gradient goes to the end that set it (ties to the first end).
+fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[Aabb]) -> f32 {
     let mut total = 0.0;
-    for w in 0..H.saturating_sub(1) {
-        for (s, &active) in boxes[w].active.iter().enumerate() {
-            if !active {
+    let union = a.union.union(&b.union);
+    for o in obstacles.iter().filter(|o| overlaps(&union, o)) {
+        for s in 0..SLOTS {
+            if !a.boxes.active[s] {
                 continue;
             }
-            let (a, b) = (&boxes[w].aabb[s], &boxes[w + 1].aabb[s]);
-            let swept = a.union(b);
-            for o in obstacles {
-                if let Some((v, d_min, d_max)) = volume_with_gradient(&swept, o) {
-                    total += v;
-                    for k in 0..3 {
-                        let from_min = w + usize::from(b.min[k] < a.min[k]);
-                        let from_max = w + usize::from(b.max[k] > a.max[k]);
-                        bounds[from_min][s][0][k] += d_min[k];
-                        bounds[from_max][s][1][k] += d_max[k];
-                    }
+            let (box_a, box_b) = (a.boxes.aabb[s], b.boxes.aabb[s]);
+            if let Some((v, d_min, d_max)) = volume_with_gradient(&box_a.union(&box_b), o) {
+                total += v;
+                for k in 0..3 {
+                    let min_end = if box_b.min[k] < box_a.min[k] { &mut *b } else { &mut *a };
+                    min_end.bound[s][0][k] += d_min[k];
+                    min_end.touched = true;
+                    let max_end = if box_b.max[k] > box_a.max[k] { &mut *b } else { &mut *a };
+                    max_end.bound[s][1][k] += d_max[k];
+                    max_end.touched = true;
                 }
             }
         }
@@ -239,35 +302,29 @@ fn swept<const H: usize>(boxes: &[RobotBoxes; H], obstacles: &[Aabb], bounds: &m
 }
 
 /// Joint gradient of one waypoint from the gradient on its boxes' bounds: each bound's share
-/// goes to the corner that set it, then through the FK adjoint (the held object's corners are
-/// points fixed in the hand frame: `∂/∂t += g`, `∂/∂R += g·localᵀ`).
-fn waypoint_gradient(
-    k: &Kinematics<f32>,
-    robot: &RobotBoxes,
-    bound: &BoundGradient,
-    held: Option<&[Vector3<f32>; CORNERS]>,
-) -> Result<Joints<f32>, Error> {
-    let mut corner_grad: CornerGradient<f32> = [[Vector3::zeros(); CORNERS]; BODIES];
-    let mut hand = (HAND_FRAME, Vector3::zeros(), Matrix3::zeros());
-    for (s, (sides, args)) in bound.iter().zip(robot.arg.iter()).enumerate() {
+/// pulls on the corner that set it, a point moving with the body's frame (the held object's
+/// with the hand), and the FK adjoint takes it to the joints.
+fn waypoint_gradient(w: &Waypoint, held: Option<&[Vector3<f32>; CORNERS]>) -> Result<Joints<f32>, Error> {
+    let mut cot = Cotangent::new();
+    for (s, (sides, args)) in w.bound.iter().zip(w.boxes.arg.iter()).enumerate() {
         for (side, arg) in sides.iter().zip(args.iter()) {
             for (axis, (&g, &corner)) in side.iter().zip(arg.iter()).enumerate() {
                 if g == 0.0 {
                     continue;
                 }
                 let corner = usize::from(corner) % CORNERS;
-                if let Some(body) = corner_grad.get_mut(s) {
-                    body[corner][axis] += g;
-                } else if let Some(local) = held {
-                    let mut gv = Vector3::zeros();
-                    gv[axis] = g;
-                    hand.1 += gv;
-                    hand.2 += gv * local[corner].transpose();
-                }
+                let (frame, point) = match (PANDA.bodies.get(s), held) {
+                    (Some(body), _) => (body.frame, box_corner(&w.k.boxes[s], &body.half_extents, corner)),
+                    (None, Some(local)) => (HAND_FRAME, w.k.frames[HAND_FRAME].transform_point(&local[corner])),
+                    (None, None) => continue,
+                };
+                let mut pull = Vector3::zeros();
+                pull[axis] = g;
+                cot.add_point(frame, &point, &pull);
             }
         }
     }
-    k.adjoint_with_frames(&corner_grad, &[hand])
+    w.k.joint_gradient(&cot)
 }
 
 #[cfg(test)]

@@ -62,6 +62,74 @@ pub const CORNERS: usize = 8;
 /// Upstream gradient on the 8 world corners of every collision body.
 pub type CornerGradient<T> = [[Vector3<T>; CORNERS]; BODIES];
 
+/// An upstream gradient, gathered per frame as the force `F = Σ g` and the moment
+/// `M = Σ p×g (+ Σ_j R_j×G_j)` about the world origin that it exerts on that frame; see the
+/// module docs. Fill it with [`Self::add_point`] and [`Self::add_frame`], then call
+/// [`Kinematics::joint_gradient`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cotangent<T: Real> {
+    force: [Vector3<T>; FRAMES],
+    moment: [Vector3<T>; FRAMES],
+    /// Σ x·0 over every input: zero unless some input was NaN or infinite.
+    probe: T,
+}
+
+impl<T: Real> Default for Cotangent<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<T: Real> Cotangent<T> {
+    /// No gradient yet.
+    pub fn new() -> Self {
+        Self {
+            force: [Vector3::zeros(); FRAMES],
+            moment: [Vector3::zeros(); FRAMES],
+            probe: T::zero(),
+        }
+    }
+
+    fn probe(&mut self, values: &[Vector3<T>]) {
+        for v in values {
+            self.probe += v.x * T::zero() + v.y * T::zero() + v.z * T::zero();
+        }
+    }
+
+    /// Gradient `grad` on the world point `point`, which moves rigidly with frame `frame`.
+    /// An out-of-range frame poisons the result ([`Error::NonFiniteGradient`]).
+    pub fn add_point(&mut self, frame: usize, point: &Vector3<T>, grad: &Vector3<T>) {
+        self.probe(core::slice::from_ref(grad));
+        match (self.force.get_mut(frame), self.moment.get_mut(frame)) {
+            (Some(f), Some(m)) => {
+                *f += grad;
+                *m += point.cross(grad);
+            }
+            // Frames come from the robot tables; a wrong index is a bug, reported, not a panic.
+            _ => self.probe = T::one(),
+        }
+    }
+
+    /// Gradient on the world pose of frame `frame` (`pose`, as computed by [`forward`]):
+    /// `d_translation = ∂L/∂t`, `d_rotation = ∂L/∂R`.
+    pub fn add_frame(&mut self, frame: usize, pose: &Pose<T>, d_translation: &Vector3<T>, d_rotation: &Matrix3<T>) {
+        self.probe(core::slice::from_ref(d_translation));
+        for j in 0..3 {
+            self.probe(&[d_rotation.column(j).into_owned()]);
+        }
+        match (self.force.get_mut(frame), self.moment.get_mut(frame)) {
+            (Some(f), Some(m)) => {
+                *f += d_translation;
+                *m += pose.translation.cross(d_translation);
+                for j in 0..3 {
+                    *m += pose.rotation.column(j).cross(&d_rotation.column(j));
+                }
+            }
+            _ => self.probe = T::one(),
+        }
+    }
+}
+
 /// World poses of every link frame and every collision box for one configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kinematics<T: Real> {
@@ -69,6 +137,12 @@ pub struct Kinematics<T: Real> {
     pub frames: [Pose<T>; FRAMES],
     /// World pose of each collision box (centre and axes; see `robot::BODY_NAMES`).
     pub boxes: [Pose<T>; BODIES],
+}
+
+/// Corner `k` of the box with half extents `half` at `pose` (bit `i` of `k` set: `+half_i`).
+pub fn box_corner<T: Real>(pose: &Pose<T>, half: &Vector3<T>, k: usize) -> Vector3<T> {
+    let s = |bit: usize, h: T| if k >> bit & 1 == 1 { h } else { -h };
+    pose.transform_point(&Vector3::new(s(0, half.x), s(1, half.y), s(2, half.z)))
 }
 
 /// Forward kinematics: world pose of every frame and collision box.
@@ -110,18 +184,9 @@ impl<T: Real> Kinematics<T> {
 
     /// The 8 world corners of collision body `body` (see [`CORNERS`] for the order).
     pub fn corners(&self, body: usize) -> [Vector3<T>; CORNERS] {
-        let robot = T::robot();
+        let half = T::robot().bodies[body % BODIES].half_extents;
         let pose = &self.boxes[body % BODIES];
-        let h = robot.bodies[body % BODIES].half_extents;
-        let axes = [
-            pose.rotation.column(0) * h.x,
-            pose.rotation.column(1) * h.y,
-            pose.rotation.column(2) * h.z,
-        ];
-        core::array::from_fn(|k| {
-            let pick = |bit: usize, v: &Vector3<T>| if k >> bit & 1 == 1 { *v } else { -*v };
-            pose.translation + pick(0, &axes[0]) + pick(1, &axes[1]) + pick(2, &axes[2])
-        })
+        core::array::from_fn(|k| box_corner(pose, &half, k))
     }
 
     /// The corners of every collision body.
@@ -132,46 +197,34 @@ impl<T: Real> Kinematics<T> {
     /// Reverse mode: the gradient with respect to the joints of a scalar whose gradient with
     /// respect to every box corner is `corner_grad`.
     pub fn adjoint(&self, corner_grad: &CornerGradient<T>) -> Result<Joints<T>, Error> {
-        self.adjoint_with_frames(corner_grad, &[])
+        let robot = T::robot();
+        let mut cot = Cotangent::new();
+        for (b, grads) in corner_grad.iter().enumerate() {
+            // Costs pull on few bodies at a time: skip the rest without placing their corners.
+            let mut any = false;
+            for g in grads {
+                any |= g.x != T::zero() || g.y != T::zero() || g.z != T::zero();
+            }
+            if !any {
+                cot.probe(grads);
+                continue;
+            }
+            let frame = robot.bodies[b].frame;
+            for (c, g) in self.corners(b).iter().zip(grads.iter()) {
+                cot.add_point(frame, c, g);
+            }
+        }
+        self.joint_gradient(&cot)
     }
 
-    /// Like [`Self::adjoint`], plus upstream gradients on frame poses:
-    /// `(frame, ∂L/∂translation, ∂L/∂rotation)` entries (repeats add up).
-    pub fn adjoint_with_frames(
-        &self,
-        corner_grad: &CornerGradient<T>,
-        frame_grad: &[(usize, Vector3<T>, Matrix3<T>)],
-    ) -> Result<Joints<T>, Error> {
-        let finite = |v: &[T]| v.iter().all(|x| x.finite());
-        let corners_ok = corner_grad.iter().flatten().all(|g| finite(g.as_slice()));
-        let frames_ok = frame_grad
-            .iter()
-            .all(|(f, gt, gr)| *f < FRAMES && finite(gt.as_slice()) && finite(gr.as_slice()));
-        if !corners_ok || !frames_ok {
+    /// Reverse mode for any upstream gradient collected in `cot`: one leaf-to-root sweep.
+    pub fn joint_gradient(&self, cot: &Cotangent<T>) -> Result<Joints<T>, Error> {
+        // x·0 is 0 for every finite x and NaN otherwise: the probe saw every input.
+        if cot.probe != T::zero() {
             return Err(Error::NonFiniteGradient);
         }
-
         let robot = T::robot();
-        // Per-frame force F and moment M (about the world origin) of the upstream gradient.
-        let mut force = [Vector3::<T>::zeros(); FRAMES];
-        let mut moment = [Vector3::<T>::zeros(); FRAMES];
-        for (b, grads) in corner_grad.iter().enumerate() {
-            let frame = robot.bodies[b].frame.min(FRAMES - 1);
-            let corners = self.corners(b);
-            for (c, g) in corners.iter().zip(grads.iter()) {
-                force[frame] += g;
-                moment[frame] += c.cross(g);
-            }
-        }
-        for (frame, gt, gr) in frame_grad {
-            let pose = &self.frames[*frame];
-            force[*frame] += gt;
-            moment[*frame] += pose.translation.cross(gt);
-            for j in 0..3 {
-                moment[*frame] += pose.rotation.column(j).cross(&gr.column(j));
-            }
-        }
-        // Leaf to root: fold each subtree into its parent, reading joints on the way.
+        let (mut force, mut moment) = (cot.force, cot.moment);
         let mut dq = [T::zero(); JOINTS];
         for i in (1..FRAMES).rev() {
             let spec = &robot.frames[i];
@@ -185,7 +238,11 @@ impl<T: Real> Kinematics<T> {
             force[parent] += f;
             moment[parent] += m;
         }
-        if dq.iter().all(|x| x.finite()) {
+        let mut probe = T::zero();
+        for &x in &dq {
+            probe += x * T::zero();
+        }
+        if probe == T::zero() {
             Ok(dq)
         } else {
             Err(Error::Overflow)

@@ -1,7 +1,7 @@
 //! Property tests: the hand-written adjoint against f64 central differences, and the TCP
 //! Jacobian against the adjoint.
 
-use edmp_core::kinematics::{CORNERS, forward};
+use edmp_core::kinematics::{CORNERS, Cotangent, forward};
 use edmp_core::robot::{BODIES, JOINTS, PANDA, TCP_FRAME};
 use edmp_tests::{check_adjoint, finite_difference, gradient_scale, zero_gradient};
 use nalgebra::{Matrix3, Vector3};
@@ -74,12 +74,13 @@ proptest! {
         for r in 0..6 {
             let mut e = Vector3::zeros();
             e[r % 3] = 1.0f32;
-            let frame_grad = if r < 3 {
-                (TCP_FRAME, e, Matrix3::zeros())
+            let mut cot = Cotangent::new();
+            if r < 3 {
+                cot.add_frame(TCP_FRAME, k.tcp(), &e, &Matrix3::zeros());
             } else {
-                (TCP_FRAME, Vector3::zeros(), e.cross_matrix() * rot * 0.5)
-            };
-            let row = k.adjoint_with_frames(&zero_gradient(), &[frame_grad]).unwrap();
+                cot.add_frame(TCP_FRAME, k.tcp(), &Vector3::zeros(), &(e.cross_matrix() * rot * 0.5));
+            }
+            let row = k.joint_gradient(&cot).unwrap();
             for j in 0..JOINTS {
                 prop_assert!((row[j] - jac[r][j]).abs() <= 1e-5, "row {} joint {}: adjoint {} vs jacobian {}", r, j, row[j], jac[r][j]);
             }
