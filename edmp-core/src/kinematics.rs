@@ -209,10 +209,15 @@ impl<T: Real> Kinematics<T> {
                 cot.probe(grads);
                 continue;
             }
-            let frame = robot.bodies[b].frame;
+            cot.probe(grads);
+            let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
             for (c, g) in self.corners(b).iter().zip(grads.iter()) {
-                cot.add_point(frame, c, g);
+                force += g;
+                moment += c.cross(g);
             }
+            let frame = robot.bodies[b].frame.min(FRAMES - 1);
+            cot.force[frame] += force;
+            cot.moment[frame] += moment;
         }
         self.joint_gradient(&cot)
     }
