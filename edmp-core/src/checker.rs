@@ -471,6 +471,26 @@ mod tests {
     }
 
     #[test]
+    fn the_held_object_counts_against_obstacles() {
+        // A 30 cm rod held along the hand's z: an obstacle at its far end touches only the rod.
+        let k = forward(&READY).unwrap();
+        let hand = &k.frames[HAND_FRAME];
+        let tip = hand.transform_point(&Vector3::new(0.0, 0.0, 0.38));
+        let mut scene = Scene::<4>::new();
+        scene.push(Obstacle::sphere(tip.into(), 0.03).unwrap()).unwrap();
+        assert_eq!(check_state(&scene, &READY, &CheckConfig::default()), Ok(None));
+        scene.hold(Obstacle::cuboid([0.0, 0.0, 0.2], [0.02, 0.02, 0.3], ID).unwrap());
+        let contact = check_state(&scene, &READY, &CheckConfig::default()).unwrap();
+        assert_eq!(
+            contact,
+            Some(Contact::Obstacle {
+                body: HELD_BODY,
+                obstacle: 0
+            })
+        );
+    }
+
+    #[test]
     fn bad_settings_and_huge_segments_are_errors() {
         let scene = Scene::<1>::new();
         let cfg = CheckConfig {

@@ -196,9 +196,19 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     if !(clearance.is_finite() && expansion.is_finite() && clearance >= 0.0 && expansion >= 0.0) {
         return Err(Error::BadParameter);
     }
+    // Refuse bad input before any work, so the error names it whatever comes later.
+    for q in trajectory {
+        if let Some(joint) = q.iter().position(|x| !x.is_finite()) {
+            return Err(Error::NonFiniteJoint { joint: joint as u8 });
+        }
+    }
     let mut obstacles = [EMPTY; N];
     for (slot, o) in obstacles.iter_mut().zip(scene.obstacles()) {
         *slot = obstacle_aabb(o, &config.inflation, config.cylinder);
+        // Finite but huge sizes or inflation can overflow the box (and 0·∞ make it NaN).
+        if !(slot.min.iter().chain(slot.max.iter()).all(|x| x.is_finite())) {
+            return Err(Error::Overflow);
+        }
     }
     let obstacles = &obstacles[..scene.obstacles().len()];
     let held = scene.held().map(|h| held_local_corners(h, config.cylinder));
@@ -377,6 +387,29 @@ mod tests {
         // A stationary trajectory sweeps exactly its boxes: sv over 3 segments = iv over 2 interior waypoints × 3/2.
         let sv = trajectory_cost(&scene, &traj, &config(CostKind::Swept), None).unwrap();
         assert!((sv - iv * 1.5).abs() <= 1e-6 * sv, "{sv} vs {iv}");
+    }
+
+    #[test]
+    fn a_bad_joint_is_named_even_after_an_overflow() {
+        // Found by the `costs` fuzz target: with finite but huge inflation the overflow used to
+        // be reported before the NaN at waypoint 3 was reached.
+        let mut scene = Scene::<1>::new();
+        scene.push(Obstacle::cuboid([0.0; 3], [0.1; 3], ID).unwrap()).unwrap();
+        let mut traj = [READY; 5];
+        let mut c = config(CostKind::Intersection);
+        c.inflation = Inflation {
+            clearance: 3e38,
+            expansion: 3e38,
+        };
+        assert_eq!(
+            trajectory_cost(&scene, &traj, &c, Some(&mut [[0.0; 7]; 5])),
+            Err(Error::Overflow)
+        );
+        traj[3][2] = f32::NAN;
+        assert_eq!(
+            trajectory_cost(&scene, &traj, &c, Some(&mut [[0.0; 7]; 5])),
+            Err(Error::NonFiniteJoint { joint: 2 })
+        );
     }
 
     #[test]
