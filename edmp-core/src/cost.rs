@@ -1,7 +1,8 @@
 //! EDMP's collision costs on a trajectory, with their hand-written adjoint.
 //!
 //! Every moving robot body (collision bodies not attached to the fixed root, plus the held
-//! object) is replaced by the world AABB of its oriented box's 8 corners; every obstacle by the
+//! object) is replaced by the world AABB of its oriented box's 8 corners (for the robot's
+//! boxes computed directly as `centre ± |R|·half`); every obstacle by the
 //! world AABB of its inflated box ([`obstacle_aabb`]). Then, as in the original code:
 //! - **intersection volume** (iv): `Σ ∏ max(0, overlap)` over the interior waypoints
 //!   `1..H-1`, bodies and obstacles;
@@ -10,8 +11,9 @@
 //!
 //! The gradient runs backwards through the product, through the min/max that chose each AABB
 //! bound (the arg-extremal corner, or the segment end that set a swept bound; ties go to the
-//! first), and through [`Kinematics::adjoint`]. Waypoints whose boxes touch nothing get an
-//! exact zero without running the adjoint.
+//! first), onto that corner as a point moving with its frame ([`Cotangent::add_point`]), and
+//! through [`Kinematics::joint_gradient`]. Waypoints whose boxes touch nothing get an exact
+//! zero without running the adjoint.
 
 use crate::error::Error;
 use crate::geometry::{Aabb, CylinderBox, Inflation, box_dims, obstacle_aabb};

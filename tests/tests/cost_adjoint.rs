@@ -156,6 +156,36 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Obstacles beyond the arm's reach (≤ 1.2 m from the base, plus inflation) cost nothing
+    /// and pull on nothing, whatever the trajectory and settings.
+    #[test]
+    fn far_obstacles_cost_exactly_zero(c in case(), dir in prop::array::uniform3(-1.0f32..1.0), far in 2.5f32..10.0) {
+        let n = dir.iter().map(|x| x * x).sum::<f32>().sqrt().max(1e-3);
+        let mut scene = Scene::<16>::new();
+        scene.push(Obstacle::sphere(dir.map(|x| x / n * far), 0.3).unwrap()).unwrap();
+        if let Some(held) = c.scene.held() {
+            scene.hold(*held);
+        }
+        let mut grad = [[1.0f32; JOINTS]; H];
+        let cost = trajectory_cost(&scene, &c.trajectory, &c.config, Some(&mut grad)).unwrap();
+        prop_assert_eq!(cost, 0.0);
+        prop_assert!(grad.iter().flatten().all(|&g| g == 0.0));
+    }
+
+    /// The intersection of a box with itself is its volume.
+    #[test]
+    fn identical_boxes_intersect_in_their_volume(lo in prop::array::uniform3(-2.0f32..2.0), size in prop::array::uniform3(0.001f32..1.0)) {
+        let min = nalgebra::Vector3::from(lo);
+        let max = min + nalgebra::Vector3::from(size);
+        let a = edmp_core::geometry::Aabb { min, max };
+        let d = max - min;
+        prop_assert_eq!(a.intersection_volume(&a), d.x * d.y * d.z);
+    }
+}
+
 #[test]
 fn original_cylinder_boxing_under_covers() {
     // The switch reproduces the original's (r, r, h) box: a quarter of the footprint.
