@@ -1,10 +1,12 @@
 //! FK and FK + adjoint timings (issue targets: FK ≤ 0.5 µs, FK + adjoint ≤ 1.5 µs per
-//! configuration on one core). Run: `cargo bench -p edmp-core --bench fk`.
+//! configuration on one core), and inverse kinematics. Run: `cargo bench -p edmp-core --bench fk`.
 
 use core::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use edmp_core::ik::{IkConfig, solve};
 use edmp_core::kinematics::{CORNERS, CornerGradient, forward};
 use edmp_core::robot::{BODIES, JOINTS, PANDA};
+use edmp_core::scene::Scene;
 use nalgebra::Vector3;
 
 /// A fixed pseudo-random sequence in [0, 1) (splitmix-style), so the bench inputs are stable.
@@ -66,6 +68,20 @@ fn bench(c: &mut Criterion) {
                 }
             }
             acc
+        })
+    });
+    // Inverse kinematics of reachable TCP poses (FK of the first 100 configurations), from the
+    // ready pose: the time of one solve, averaged over the 100.
+    let targets: Vec<_> = qs.iter().take(100).map(|q| *forward(q).unwrap().tcp()).collect();
+    let ready = [0.0f32, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
+    let scene = Scene::<1>::new();
+    group.throughput(Throughput::Elements(targets.len() as u64));
+    group.bench_function("ik/100 reachable poses (self-collision checked)", |b| {
+        b.iter(|| {
+            targets
+                .iter()
+                .filter(|t| solve(t, &ready, &scene, &IkConfig::default()).is_ok())
+                .count()
         })
     });
     group.finish();

@@ -1,8 +1,9 @@
 //! Forward kinematics of the Panda, its hand-written adjoint, and frame Jacobians.
 //!
 //! [`forward`] maps 7 joint angles to the world pose of every link frame and of every
-//! collision box. [`Kinematics::adjoint`] takes an upstream gradient on box corners (and, if
-//! wanted, on frame poses) back to the joints in one leaf-to-root sweep:
+//! collision box. [`Kinematics::adjoint`] takes an upstream gradient on box corners back to the
+//! joints; [`Cotangent`] gathers any other (on points moving with a frame, on frame poses) for
+//! [`Kinematics::joint_gradient`]. Both end in one leaf-to-root sweep:
 //!
 //! a turn `dq` of revolute joint `i` (world axis `a`, through world point `o`) moves every
 //! point `p` downstream by `dq·a×(p−o)` and turns every frame by `dq·[a]×R`. So with the
