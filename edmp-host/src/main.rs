@@ -5,6 +5,9 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod fk;
+mod json;
+mod rrt;
+mod rrt_cmd;
 
 /// EDMP motion planning for the Franka Panda.
 #[derive(Debug, Parser)]
@@ -18,16 +21,23 @@ struct Cli {
 enum Command {
     /// Forward kinematics: world pose of every link frame, collision box and the TCP.
     Fk(fk::Args),
+    /// Plan with the RRT-Connect baseline (exit 0: planned, 1: no path, 2: bad input).
+    Rrt(rrt_cmd::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Fk(args) => fk::run(&args),
+        Command::Fk(args) => fk::run(&args).map_err(rrt_cmd::Failure::Input),
+        Command::Rrt(args) => rrt_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(message) => {
+        Err(rrt_cmd::Failure::NoPath(message)) => {
+            eprintln!("edmp-host: {message}");
+            ExitCode::from(1)
+        }
+        Err(rrt_cmd::Failure::Input(message)) => {
             eprintln!("edmp-host: {message}");
             ExitCode::from(2)
         }

@@ -1,0 +1,316 @@
+//! The `edmp-scene/1` format (`shared/spec/formats.md`): parsing with errors that name the
+//! offending field by its JSON path, e.g. `obstacles[3].quaternion: norm 0.71, expected 1`.
+
+use edmp_core::checker::{CheckConfig, Contact, check_state};
+use edmp_core::kinematics::Joints;
+use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS, PANDA};
+use edmp_core::scene::{MAX_OBSTACLES, Obstacle, QUATERNION_NORM_TOLERANCE, Scene, SceneError};
+use serde_json::{Map, Value};
+use std::fmt;
+
+/// A field of the input that is wrong, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct InputError {
+    path: String,
+    message: String,
+}
+
+impl InputError {
+    fn at(path: &str, message: impl Into<String>) -> Self {
+        Self {
+            path: path.to_string(),
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for InputError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.path.is_empty() {
+            f.write_str(&self.message)
+        } else {
+            write!(f, "{}: {}", self.path, self.message)
+        }
+    }
+}
+
+/// The goal of a problem.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Goal {
+    /// A joint configuration.
+    Joints(Joints<f32>),
+    /// A TCP pose: position and quaternion `[w, x, y, z]`.
+    Pose { position: [f32; 3], quaternion: [f32; 4] },
+}
+
+/// A parsed, validated problem.
+#[derive(Clone, Debug)]
+pub(crate) struct Problem {
+    pub scene: Scene<MAX_OBSTACLES>,
+    pub start: Joints<f32>,
+    pub goal: Goal,
+}
+
+fn object<'a>(v: &'a Value, path: &str, allowed: &[&str]) -> Result<&'a Map<String, Value>, InputError> {
+    let map = v
+        .as_object()
+        .ok_or_else(|| InputError::at(path, "expected an object"))?;
+    for key in map.keys() {
+        if !allowed.contains(&key.as_str()) {
+            let at = if path.is_empty() {
+                key.clone()
+            } else {
+                format!("{path}.{key}")
+            };
+            return Err(InputError::at(
+                &at,
+                format!("unknown field (expected one of: {})", allowed.join(", ")),
+            ));
+        }
+    }
+    Ok(map)
+}
+
+fn field<'a>(map: &'a Map<String, Value>, path: &str, key: &str) -> Result<(&'a Value, String), InputError> {
+    let at = if path.is_empty() {
+        key.to_string()
+    } else {
+        format!("{path}.{key}")
+    };
+    map.get(key)
+        .map(|v| (v, at.clone()))
+        .ok_or_else(|| InputError::at(&at, "missing"))
+}
+
+fn number(v: &Value, path: &str) -> Result<f32, InputError> {
+    let x = v
+        .as_f64()
+        .ok_or_else(|| InputError::at(path, format!("expected a number, found {v}")))?;
+    let y = x as f32;
+    if !y.is_finite() {
+        return Err(InputError::at(path, format!("{x} is not a finite f32")));
+    }
+    Ok(y)
+}
+
+fn numbers<const K: usize>(v: &Value, path: &str) -> Result<[f32; K], InputError> {
+    let items = v
+        .as_array()
+        .ok_or_else(|| InputError::at(path, format!("expected an array of {K} numbers")))?;
+    if items.len() != K {
+        return Err(InputError::at(
+            path,
+            format!("expected {K} numbers, found {}", items.len()),
+        ));
+    }
+    let mut out = [0.0; K];
+    for (i, (slot, item)) in out.iter_mut().zip(items).enumerate() {
+        *slot = number(item, &format!("{path}[{i}]"))?;
+    }
+    Ok(out)
+}
+
+fn quaternion(v: &Value, path: &str) -> Result<[f32; 4], InputError> {
+    let q = numbers::<4>(v, path)?;
+    let norm = q.iter().map(|x| x * x).sum::<f32>().sqrt();
+    if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+        return Err(InputError::at(path, format!("norm {norm:.2}, expected 1")));
+    }
+    Ok(q)
+}
+
+fn primitive(v: &Value, path: &str) -> Result<Obstacle, InputError> {
+    let kind = v
+        .get("type")
+        .and_then(Value::as_str)
+        .ok_or_else(|| InputError::at(&format!("{path}.type"), "missing (cuboid, cylinder or sphere)"))?;
+    match kind {
+        "cuboid" => {
+            let map = object(v, path, &["type", "center", "dims", "quaternion"])?;
+            let (c, cp) = field(map, path, "center")?;
+            let (d, dp) = field(map, path, "dims")?;
+            let (q, qp) = field(map, path, "quaternion")?;
+            let (center, dims, quat) = (numbers::<3>(c, &cp)?, numbers::<3>(d, &dp)?, quaternion(q, &qp)?);
+            Obstacle::cuboid(center, dims, quat).map_err(|e| scene_error(e, path, "dims"))
+        }
+        "cylinder" => {
+            let map = object(v, path, &["type", "center", "radius", "height", "quaternion"])?;
+            let (c, cp) = field(map, path, "center")?;
+            let (r, rp) = field(map, path, "radius")?;
+            let (h, hp) = field(map, path, "height")?;
+            let (q, qp) = field(map, path, "quaternion")?;
+            let (center, radius, height, quat) = (
+                numbers::<3>(c, &cp)?,
+                number(r, &rp)?,
+                number(h, &hp)?,
+                quaternion(q, &qp)?,
+            );
+            let size = if radius > 0.0 { "height" } else { "radius" };
+            Obstacle::cylinder(center, radius, height, quat).map_err(|e| scene_error(e, path, size))
+        }
+        "sphere" => {
+            let map = object(v, path, &["type", "center", "radius"])?;
+            let (c, cp) = field(map, path, "center")?;
+            let (r, rp) = field(map, path, "radius")?;
+            Obstacle::sphere(numbers::<3>(c, &cp)?, number(r, &rp)?).map_err(|e| scene_error(e, path, "radius"))
+        }
+        other => Err(InputError::at(
+            &format!("{path}.type"),
+            format!("unknown type {other:?} (cuboid, cylinder or sphere)"),
+        )),
+    }
+}
+
+fn scene_error(e: SceneError, path: &str, size_field: &str) -> InputError {
+    match e {
+        SceneError::NonPositiveSize => InputError::at(&format!("{path}.{size_field}"), "must be positive"),
+        other => InputError::at(path, other.to_string()),
+    }
+}
+
+fn joints(v: &Value, path: &str) -> Result<Joints<f32>, InputError> {
+    let q = numbers::<JOINTS>(v, path)?;
+    for (j, &x) in q.iter().enumerate() {
+        let (lo, hi) = (PANDA.soft_lower[j], PANDA.soft_upper[j]);
+        if x < lo - 1e-5 || x > hi + 1e-5 {
+            return Err(InputError::at(
+                &format!("{path}[{j}]"),
+                format!("{x} outside {}'s limits [{lo}, {hi}]", JOINT_NAMES[j]),
+            ));
+        }
+    }
+    Ok(q)
+}
+
+fn describe(contact: Contact) -> String {
+    let body = |b: u8| BODY_NAMES.get(usize::from(b)).copied().unwrap_or("held_object");
+    match contact {
+        Contact::Obstacle { body: b, obstacle } => format!("{} touches obstacles[{obstacle}]", body(b)),
+        Contact::SelfContact { first, second } => format!("{} touches {}", body(first), body(second)),
+    }
+}
+
+/// Parses and validates an `edmp-scene/1` document.
+pub(crate) fn parse_problem(text: &str) -> Result<Problem, InputError> {
+    let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
+    let map = object(&root, "", &["format", "obstacles", "start", "goal", "held_object"])?;
+    let (format, fp) = field(map, "", "format")?;
+    if format.as_str() != Some("edmp-scene/1") {
+        return Err(InputError::at(
+            &fp,
+            format!("expected \"edmp-scene/1\", found {format}"),
+        ));
+    }
+    let (obstacles, op) = field(map, "", "obstacles")?;
+    let list = obstacles
+        .as_array()
+        .ok_or_else(|| InputError::at(&op, "expected an array"))?;
+    if list.len() > MAX_OBSTACLES {
+        return Err(InputError::at(
+            &op,
+            format!("{} obstacles, at most {MAX_OBSTACLES}", list.len()),
+        ));
+    }
+    let mut scene = Scene::<MAX_OBSTACLES>::new();
+    for (i, o) in list.iter().enumerate() {
+        let built = primitive(o, &format!("obstacles[{i}]"))?;
+        scene.push(built).map_err(|e| InputError::at(&op, e.to_string()))?;
+    }
+    if let Some(held) = map.get("held_object") {
+        scene.hold(primitive(held, "held_object")?);
+    }
+    let (start, sp) = field(map, "", "start")?;
+    let start = joints(start, &sp)?;
+    if let Some(c) =
+        check_state(&scene, &start, &CheckConfig::default()).map_err(|e| InputError::at(&sp, e.to_string()))?
+    {
+        return Err(InputError::at(&sp, format!("in collision: {}", describe(c))));
+    }
+    let (goal, gp) = field(map, "", "goal")?;
+    let goal_map = object(goal, &gp, &["joints", "pose"])?;
+    let goal = match (goal_map.get("joints"), goal_map.get("pose")) {
+        (Some(q), None) => {
+            let path = format!("{gp}.joints");
+            let q = joints(q, &path)?;
+            if let Some(c) =
+                check_state(&scene, &q, &CheckConfig::default()).map_err(|e| InputError::at(&path, e.to_string()))?
+            {
+                return Err(InputError::at(&path, format!("in collision: {}", describe(c))));
+            }
+            Goal::Joints(q)
+        }
+        (None, Some(pose)) => {
+            let path = format!("{gp}.pose");
+            let pm = object(pose, &path, &["position", "quaternion"])?;
+            let (p, pp) = field(pm, &path, "position")?;
+            let (q, qp) = field(pm, &path, "quaternion")?;
+            Goal::Pose {
+                position: numbers::<3>(p, &pp)?,
+                quaternion: quaternion(q, &qp)?,
+            }
+        }
+        _ => return Err(InputError::at(&gp, "expected exactly one of \"joints\" or \"pose\"")),
+    };
+    Ok(Problem { scene, start, goal })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"{
+      "format": "edmp-scene/1",
+      "obstacles": [
+        {"type": "cuboid", "center": [0.6, 0.0, 0.2], "dims": [0.4, 0.8, 0.02], "quaternion": [1, 0, 0, 0]},
+        {"type": "cylinder", "center": [0.5, 0.4, 0.3], "radius": 0.04, "height": 0.2, "quaternion": [1, 0, 0, 0]},
+        {"type": "sphere", "center": [0.4, -0.4, 0.6], "radius": 0.05}
+      ],
+      "start": [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785],
+      "goal": {"joints": [0.3, -0.5, 0.1, -2.0, 0.0, 1.6, 0.9]},
+      "held_object": {"type": "cuboid", "center": [0, 0, 0.16], "dims": [0.03, 0.03, 0.06], "quaternion": [1, 0, 0, 0]}
+    }"#;
+
+    fn error_of(text: &str) -> String {
+        parse_problem(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn parses_the_spec_example() {
+        let p = parse_problem(GOOD).unwrap();
+        assert_eq!(p.scene.obstacles().len(), 3);
+        assert!(p.scene.held().is_some());
+        assert!(matches!(p.goal, Goal::Joints(_)));
+    }
+
+    #[test]
+    fn errors_name_the_field() {
+        let bad_quat = GOOD.replace(
+            r#""dims": [0.4, 0.8, 0.02], "quaternion": [1, 0, 0, 0]"#,
+            r#""dims": [0.4, 0.8, 0.02], "quaternion": [0.71, 0, 0, 0]"#,
+        );
+        assert_eq!(error_of(&bad_quat), "obstacles[0].quaternion: norm 0.71, expected 1");
+        let short = GOOD.replace("[0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]", "[0.0, -0.785]");
+        assert_eq!(error_of(&short), "start: expected 7 numbers, found 2");
+        let typo = GOOD.replace(r#""radius": 0.05}"#, r#""radius": 0.05, "colour": 1}"#);
+        assert!(error_of(&typo).starts_with("obstacles[2].colour: unknown field"));
+        let negative = GOOD.replace(r#""radius": 0.04"#, r#""radius": -0.04"#);
+        assert_eq!(error_of(&negative), "obstacles[1].radius: must be positive");
+        let limits = GOOD.replace(
+            "[0.3, -0.5, 0.1, -2.0, 0.0, 1.6, 0.9]",
+            "[0.3, -0.5, 0.1, 0.5, 0.0, 1.6, 0.9]",
+        );
+        assert!(error_of(&limits).starts_with("goal.joints[3]: 0.5 outside panda_joint4's limits"));
+        let nan = GOOD.replace("\"radius\": 0.05", "\"radius\": \"x\"");
+        assert!(error_of(&nan).starts_with("obstacles[2].radius: expected a number"));
+        let collide = GOOD.replace(
+            r#""center": [0.4, -0.4, 0.6], "radius": 0.05"#,
+            r#""center": [0.3, 0.0, 0.6], "radius": 0.1"#,
+        );
+        assert!(
+            error_of(&collide).starts_with("start: in collision:"),
+            "{}",
+            error_of(&collide)
+        );
+        assert!(error_of("{").starts_with("not valid JSON"));
+    }
+}

@@ -1,0 +1,90 @@
+//! `edmp-host rrt`: the RRT-Connect baseline on one `edmp-scene/1` file, written as an
+//! `edmp-plan/1` plan (status "success" only: without a path nothing is written, exit 1).
+
+use crate::json::{Goal, parse_problem};
+use crate::rrt::{RrtConfig, RrtError, path_length, plan};
+use core::time::Duration;
+use edmp_core::ik::{IkConfig, solve};
+use edmp_core::kinematics::Pose;
+use edmp_core::scene::rotation_from_wxyz;
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `edmp-host rrt`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// The scene and problem (`edmp-scene/1` JSON).
+    scene: PathBuf,
+    /// Write the plan here instead of standard output.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Planning time budget in milliseconds.
+    #[arg(long, default_value_t = 1000)]
+    budget_ms: u64,
+}
+
+/// What went wrong, and the exit status it maps to.
+pub(crate) enum Failure {
+    /// Bad input or I/O: exit 2, nothing written.
+    Input(String),
+    /// Ran, found no path: exit 1, nothing written.
+    NoPath(String),
+}
+
+/// Plans and writes the plan.
+pub(crate) fn run(args: &Args) -> Result<(), Failure> {
+    let began = Instant::now();
+    let text =
+        std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let goal = match problem.goal {
+        Goal::Joints(q) => q,
+        Goal::Pose { position, quaternion } => {
+            let rotation =
+                rotation_from_wxyz(quaternion).map_err(|e| Failure::Input(format!("goal.pose.quaternion: {e}")))?;
+            let target = Pose {
+                rotation,
+                translation: position.into(),
+            };
+            solve(&target, &problem.start, &problem.scene, &IkConfig::default())
+                .map_err(|e| Failure::Input(format!("goal.pose: {e}")))?
+                .joints
+        }
+    };
+    let config = RrtConfig {
+        budget: Duration::from_millis(args.budget_ms),
+        ..RrtConfig::default()
+    };
+    let planned =
+        plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&problem.scene, &problem.start, &goal, &config, args.seed)
+            .map_err(|e| match e {
+                RrtError::Timeout => Failure::NoPath(format!("no path within {} ms", args.budget_ms)),
+                RrtError::Resample => Failure::NoPath("the resampled path cut into an obstacle".into()),
+                RrtError::InvalidStart => Failure::Input("start: in collision or outside the limits".into()),
+                RrtError::InvalidGoal => Failure::Input("goal: in collision or outside the limits".into()),
+                RrtError::Checker(e) => Failure::Input(format!("checker: {e}")),
+            })?;
+    let total_ms = began.elapsed().as_secs_f64() * 1e3;
+    let plan = json!({
+        "format": "edmp-plan/1",
+        "status": "success",
+        "planner": "rrt-connect",
+        "waypoints": planned.waypoints.iter().map(|q| q.to_vec()).collect::<Vec<_>>(),
+        "seed": args.seed,
+        "path_length": path_length(&planned.waypoints),
+        "tree_nodes": planned.nodes,
+        "timing_ms": {"total": total_ms, "search": planned.elapsed.as_secs_f64() * 1e3},
+    });
+    let text = serde_json::to_string_pretty(&plan).map_err(|e| Failure::Input(e.to_string()))? + "\n";
+    match &args.output {
+        Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display()))),
+        None => {
+            print!("{text}");
+            Ok(())
+        }
+    }
+}
