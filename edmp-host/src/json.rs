@@ -193,7 +193,17 @@ fn describe(contact: Contact) -> String {
 /// Parses and validates an `edmp-scene/1` document.
 pub(crate) fn parse_problem(text: &str) -> Result<Problem, InputError> {
     let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
-    let map = object(&root, "", &["format", "obstacles", "start", "goal", "held_object"])?;
+    // `meta` (optional, free-form provenance such as the family, seed and the TCP pose of a
+    // joint goal) is an extension of the format; the planner ignores it.
+    let map = object(
+        &root,
+        "",
+        &["format", "obstacles", "start", "goal", "held_object", "meta"],
+    )?;
+    if let Some(meta) = map.get("meta") {
+        meta.as_object()
+            .ok_or_else(|| InputError::at("meta", "expected an object"))?;
+    }
     let (format, fp) = field(map, "", "format")?;
     if format.as_str() != Some("edmp-scene/1") {
         return Err(InputError::at(

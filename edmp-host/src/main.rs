@@ -4,10 +4,13 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod bench_rrt;
 mod fk;
 mod json;
 mod rrt;
 mod rrt_cmd;
+mod scenes;
+mod suite;
 
 /// EDMP motion planning for the Franka Panda.
 #[derive(Debug, Parser)]
@@ -23,6 +26,10 @@ enum Command {
     Fk(fk::Args),
     /// Plan with the RRT-Connect baseline (exit 0: planned, 1: no path, 2: bad input).
     Rrt(rrt_cmd::Args),
+    /// Generate the benchmark suite: MpiNets-style scenes and solvable problems.
+    GenSuite(suite::Args),
+    /// Run RRT-Connect over a problem folder and print a table per family.
+    BenchRrt(bench_rrt::Args),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +37,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Fk(args) => fk::run(&args).map_err(rrt_cmd::Failure::Input),
         Command::Rrt(args) => rrt_cmd::run(&args),
+        Command::GenSuite(args) => suite::run(&args).map_err(rrt_cmd::Failure::Input),
+        Command::BenchRrt(args) => bench_rrt::run(&args).map_err(rrt_cmd::Failure::Input),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
