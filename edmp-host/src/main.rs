@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 mod bench_rrt;
 mod fk;
+mod gen_data;
 mod json;
 mod rrt;
 mod rrt_cmd;
@@ -30,6 +31,8 @@ enum Command {
     GenSuite(suite::Args),
     /// Run RRT-Connect over a problem folder and print a table per family.
     BenchRrt(bench_rrt::Args),
+    /// Generate training trajectories (RRT-Connect in generated scenes) as a `.npy` file.
+    GenData(gen_data::Args),
 }
 
 fn main() -> ExitCode {
@@ -39,6 +42,7 @@ fn main() -> ExitCode {
         Command::Rrt(args) => rrt_cmd::run(&args),
         Command::GenSuite(args) => suite::run(&args).map_err(rrt_cmd::Failure::Input),
         Command::BenchRrt(args) => bench_rrt::run(&args).map_err(rrt_cmd::Failure::Input),
+        Command::GenData(args) => gen_data::run(&args).map_err(rrt_cmd::Failure::Input),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -169,7 +169,8 @@ pub(crate) struct Environment {
 }
 
 impl Environment {
-    fn scene(&self) -> Option<Scene<MAX_OBSTACLES>> {
+    /// The environment as a core scene (`None` if a primitive is invalid or too many).
+    pub(crate) fn scene(&self) -> Option<Scene<MAX_OBSTACLES>> {
         let mut scene = Scene::new();
         for p in &self.prims {
             scene.push(p.obstacle()?).ok()?;
@@ -223,7 +224,7 @@ pub(crate) fn environment(family: Family, rng: &mut Rng) -> Environment {
 }
 
 /// A collision-free configuration reaching a random pose of `region`, tried `attempts` times.
-fn reach(
+pub(crate) fn reach(
     scene: &Scene<MAX_OBSTACLES>,
     region: &Region,
     rng: &mut Rng,
@@ -245,7 +246,7 @@ fn reach(
 }
 
 /// `NEUTRAL + U(0, 0.25)` per joint, collision-free (MpiNets' neutral candidates).
-fn neutral(scene: &Scene<MAX_OBSTACLES>, rng: &mut Rng) -> Option<Joints<f32>> {
+pub(crate) fn neutral(scene: &Scene<MAX_OBSTACLES>, rng: &mut Rng) -> Option<Joints<f32>> {
     for _ in 0..50 {
         let q: Joints<f32> =
             core::array::from_fn(|j| (NEUTRAL[j] + rng.uniform_f32(0.0, 0.25)).min(PANDA.soft_upper[j]));
