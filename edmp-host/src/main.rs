@@ -8,6 +8,7 @@ mod bench_rrt;
 mod fk;
 mod gen_data;
 mod json;
+mod render;
 mod rrt;
 mod rrt_cmd;
 mod scenes;
@@ -33,6 +34,8 @@ enum Command {
     BenchRrt(bench_rrt::Args),
     /// Generate training trajectories (RRT-Connect in generated scenes) as a `.npy` file.
     GenData(gen_data::Args),
+    /// Draw a scene (and optionally a plan) as a PNG: top and side views.
+    Render(render::Args),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +46,7 @@ fn main() -> ExitCode {
         Command::GenSuite(args) => suite::run(&args).map_err(rrt_cmd::Failure::Input),
         Command::BenchRrt(args) => bench_rrt::run(&args).map_err(rrt_cmd::Failure::Input),
         Command::GenData(args) => gen_data::run(&args).map_err(rrt_cmd::Failure::Input),
+        Command::Render(args) => render::run(&args).map_err(rrt_cmd::Failure::Input),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -51,3 +51,16 @@ fn bad_input_names_the_field_exits_2_and_writes_nothing() {
     assert!(!plan.exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn render_writes_a_png() {
+    let path = std::env::temp_dir().join(format!("edmp-render-{}.png", std::process::id()));
+    let out = edmp_host(&["render", "examples/wall.json", "-o", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    // IHDR: width 1200, height 600.
+    assert_eq!(u32::from_be_bytes([bytes[16], bytes[17], bytes[18], bytes[19]]), 1200);
+    assert_eq!(u32::from_be_bytes([bytes[20], bytes[21], bytes[22], bytes[23]]), 600);
+}

@@ -1,0 +1,233 @@
+//! `edmp-host render`: a picture of a scene (and of a plan): a top view and a side view,
+//! orthographic, obstacles in grey, the robot's collision hulls at the start (blue) and the
+//! goal (green), and with a plan its waypoints in orange, fading along the trajectory.
+//! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
+
+use crate::json::{Goal, parse_problem};
+use edmp_core::convex::{Convex, Primitive};
+use edmp_core::kinematics::{Joints, forward};
+use edmp_core::robot::{BODIES, PANDA};
+use edmp_core::scene::Shape;
+use nalgebra::Vector3;
+use std::path::PathBuf;
+
+/// Arguments of `edmp-host render`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// The scene (`edmp-scene/1`).
+    scene: PathBuf,
+    /// A plan (`edmp-plan/1`) to draw on it.
+    plan: Option<PathBuf>,
+    /// Output PNG.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+const PANEL: usize = 600;
+/// World window of both views: x (forward) and the second axis (y for the top view, z for the side).
+const X_RANGE: [f32; 2] = [-0.5, 1.4];
+const TOP_RANGE: [f32; 2] = [-0.95, 0.95];
+const SIDE_RANGE: [f32; 2] = [-0.15, 1.75];
+
+struct Canvas {
+    width: usize,
+    height: usize,
+    pixels: Vec<[f32; 3]>,
+}
+
+impl Canvas {
+    fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![[1.0; 3]; width * height],
+        }
+    }
+
+    /// Fills a convex polygon (pixel coordinates) blending `color` with opacity `alpha`.
+    fn fill(&mut self, poly: &[[f32; 2]], color: [f32; 3], alpha: f32) {
+        if poly.len() < 3 {
+            return;
+        }
+        let (lo, hi) = poly.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), p| {
+            (a.min(p[1]), b.max(p[1]))
+        });
+        let (y0, y1) = (
+            lo.max(0.0).ceil() as usize,
+            (hi.min(self.height as f32 - 1.0)).floor().max(0.0) as usize,
+        );
+        for y in y0..=y1.min(self.height - 1) {
+            let yc = y as f32;
+            let (mut left, mut right) = (f32::INFINITY, f32::NEG_INFINITY);
+            for k in 0..poly.len() {
+                let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                if (a[1] <= yc && b[1] >= yc) || (b[1] <= yc && a[1] >= yc) {
+                    let x = if (b[1] - a[1]).abs() < 1e-6 {
+                        a[0].min(b[0])
+                    } else {
+                        a[0] + (yc - a[1]) / (b[1] - a[1]) * (b[0] - a[0])
+                    };
+                    let x2 = if (b[1] - a[1]).abs() < 1e-6 { a[0].max(b[0]) } else { x };
+                    left = left.min(x);
+                    right = right.max(x2);
+                }
+            }
+            if left > right {
+                continue;
+            }
+            let (x0, x1) = (
+                left.max(0.0).ceil() as usize,
+                right.min(self.width as f32 - 1.0).floor().max(0.0) as usize,
+            );
+            for x in x0..=x1.min(self.width - 1) {
+                let p = &mut self.pixels[y * self.width + x];
+                for c in 0..3 {
+                    p[c] = p[c] * (1.0 - alpha) + color[c] * alpha;
+                }
+            }
+        }
+    }
+
+    fn png(&self, path: &std::path::Path) -> Result<(), String> {
+        let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), self.width as u32, self.height as u32);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        let bytes: Vec<u8> = self
+            .pixels
+            .iter()
+            .flat_map(|p| p.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8))
+            .collect();
+        writer.write_image_data(&bytes).map_err(|e| e.to_string())
+    }
+}
+
+/// Convex hull of 2-D points (Andrew's monotone chain), counter-clockwise.
+fn hull2(mut pts: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
+    pts.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    let cross = |o: [f32; 2], a: [f32; 2], b: [f32; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    let mut lower: Vec<[f32; 2]> = Vec::new();
+    for &p in &pts {
+        while lower.len() >= 2 && cross(lower[lower.len() - 2], lower[lower.len() - 1], p) <= 0.0 {
+            lower.pop();
+        }
+        lower.push(p);
+    }
+    let mut upper: Vec<[f32; 2]> = Vec::new();
+    for &p in pts.iter().rev() {
+        while upper.len() >= 2 && cross(upper[upper.len() - 2], upper[upper.len() - 1], p) <= 0.0 {
+            upper.pop();
+        }
+        upper.push(p);
+    }
+    lower.pop();
+    upper.pop();
+    lower.extend(upper);
+    lower
+}
+
+/// Outline points of a primitive (from its support function in 64 directions around each
+/// view axis, enough for the silhouettes of boxes, cylinders and spheres).
+fn outline(p: &Primitive) -> Vec<Vector3<f32>> {
+    let mut out = Vec::new();
+    for k in 0..64 {
+        let a = k as f32 * core::f32::consts::TAU / 64.0;
+        let (s, c) = a.sin_cos();
+        out.push(p.support(&Vector3::new(c, s, 0.0)));
+        out.push(p.support(&Vector3::new(c, 0.0, s)));
+        out.push(p.support(&Vector3::new(0.0, c, s)));
+    }
+    if let Shape::Cuboid { .. } = p.shape {
+        for k in 0..8 {
+            let d = Vector3::new(
+                if k & 1 == 1 { 1.0 } else { -1.0 },
+                if k & 2 == 2 { 1.0 } else { -1.0 },
+                if k & 4 == 4 { 1.0 } else { -1.0 },
+            );
+            out.push(p.support(&(p.rotation * d)));
+        }
+    }
+    out
+}
+
+/// Pixel of world point `p` in the top (`side = false`) or side view, with the panel offset.
+fn pixel(p: &Vector3<f32>, side: bool) -> [f32; 2] {
+    let u = (p.x - X_RANGE[0]) / (X_RANGE[1] - X_RANGE[0]) * PANEL as f32;
+    let (range, v) = if side { (SIDE_RANGE, p.z) } else { (TOP_RANGE, p.y) };
+    let v = (1.0 - (v - range[0]) / (range[1] - range[0])) * PANEL as f32;
+    [u + if side { PANEL as f32 } else { 0.0 }, v]
+}
+
+fn draw(canvas: &mut Canvas, points: &[Vector3<f32>], color: [f32; 3], alpha: f32) {
+    for side in [false, true] {
+        let poly = hull2(points.iter().map(|p| pixel(p, side)).collect());
+        canvas.fill(&poly, color, alpha);
+    }
+}
+
+fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, color: [f32; 3], alpha: f32) -> Result<(), String> {
+    let k = forward(q).map_err(|e| e.to_string())?;
+    for b in 0..BODIES {
+        let pose = &k.frames[PANDA.bodies[b].frame];
+        let pts: Vec<_> = PANDA.hull(b).iter().map(|p| pose.transform_point(p)).collect();
+        draw(canvas, &pts, color, alpha);
+    }
+    Ok(())
+}
+
+/// Draws the scene (and plan) and writes the PNG.
+pub(crate) fn run(args: &Args) -> Result<(), String> {
+    let text = std::fs::read_to_string(&args.scene).map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    let problem = parse_problem(&text).map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    let mut canvas = Canvas::new(2 * PANEL, PANEL);
+    // Panel frames and the floor line of the side view.
+    canvas.fill(
+        &[
+            [PANEL as f32 - 1.0, 0.0],
+            [PANEL as f32 + 1.0, 0.0],
+            [PANEL as f32 + 1.0, PANEL as f32],
+            [PANEL as f32 - 1.0, PANEL as f32],
+        ],
+        [0.3; 3],
+        1.0,
+    );
+    let floor = pixel(&Vector3::new(0.0, 0.0, 0.0), true)[1];
+    canvas.fill(
+        &[
+            [PANEL as f32, floor],
+            [2.0 * PANEL as f32, floor],
+            [2.0 * PANEL as f32, floor + 1.0],
+            [PANEL as f32, floor + 1.0],
+        ],
+        [0.6; 3],
+        1.0,
+    );
+    for o in problem.scene.obstacles() {
+        draw(&mut canvas, &outline(&Primitive::obstacle(o)), [0.35, 0.35, 0.38], 0.45);
+    }
+    if let Some(path) = &args.plan {
+        let plan: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+        let waypoints = plan["waypoints"]
+            .as_array()
+            .ok_or(format!("{}: waypoints: expected an array", path.display()))?;
+        let n = waypoints.len().max(1);
+        for (i, w) in waypoints.iter().enumerate().step_by(4) {
+            let q: Vec<f32> = w
+                .as_array()
+                .map(|a| a.iter().filter_map(|x| x.as_f64()).map(|x| x as f32).collect())
+                .unwrap_or_default();
+            let q: Joints<f32> = q
+                .try_into()
+                .map_err(|_| format!("{}: waypoints[{i}]: expected 7 numbers", path.display()))?;
+            draw_robot(&mut canvas, &q, [0.95, 0.55, 0.1], 0.08 + 0.2 * i as f32 / n as f32)?;
+        }
+    }
+    draw_robot(&mut canvas, &problem.start, [0.15, 0.35, 0.85], 0.35)?;
+    if let Goal::Joints(goal) = problem.goal {
+        draw_robot(&mut canvas, &goal, [0.1, 0.65, 0.25], 0.35)?;
+    }
+    canvas.png(&args.output)
+}
