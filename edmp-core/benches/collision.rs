@@ -7,32 +7,17 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use edmp_core::checker::{CheckConfig, check_trajectory};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{CylinderBox, Inflation};
+use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
 
 const H: usize = 50;
 const BATCH: usize = 12;
 
-/// splitmix64 → [0, 1): fixed inputs without a dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
-    }
-}
-
 /// A smooth 50-waypoint arc between two configurations around the ready pose.
 fn trajectory(rng: &mut Rng) -> [[f32; 7]; H] {
     let ready = [0.0f32, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-    let a: [f32; 7] = core::array::from_fn(|j| ready[j] + rng.range(-0.6, 0.6));
-    let b: [f32; 7] = core::array::from_fn(|j| ready[j] + rng.range(-0.6, 0.6));
+    let a: [f32; 7] = core::array::from_fn(|j| ready[j] + rng.uniform_f32(-0.6, 0.6));
+    let b: [f32; 7] = core::array::from_fn(|j| ready[j] + rng.uniform_f32(-0.6, 0.6));
     core::array::from_fn(|w| {
         let t = w as f32 / (H - 1) as f32;
         core::array::from_fn(|j| a[j] + (b[j] - a[j]) * t)
@@ -46,17 +31,26 @@ fn scene(rng: &mut Rng, path: &[[f32; 7]; H]) -> Scene<64> {
         .push(Obstacle::cuboid([0.5, 0.0, -0.02], [1.0, 1.2, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())
         .unwrap();
     while scene.obstacles().len() < 20 {
-        let r = rng.range(0.3, 0.9);
-        let phi = rng.range(-3.1, 3.1);
-        let center = [r * phi.cos(), r * phi.sin(), rng.range(0.0, 0.9)];
+        let r = rng.uniform_f32(0.3, 0.9);
+        let phi = rng.uniform_f32(-3.1, 3.1);
+        let center = [r * phi.cos(), r * phi.sin(), rng.uniform_f32(0.0, 0.9)];
         let o = match scene.obstacles().len() % 3 {
             0 => Obstacle::cuboid(
                 center,
-                [rng.range(0.05, 0.3), rng.range(0.05, 0.3), rng.range(0.05, 0.3)],
+                [
+                    rng.uniform_f32(0.05, 0.3),
+                    rng.uniform_f32(0.05, 0.3),
+                    rng.uniform_f32(0.05, 0.3),
+                ],
                 [1.0, 0.0, 0.0, 0.0],
             ),
-            1 => Obstacle::cylinder(center, rng.range(0.03, 0.1), rng.range(0.1, 0.4), [1.0, 0.0, 0.0, 0.0]),
-            _ => Obstacle::sphere(center, rng.range(0.03, 0.12)),
+            1 => Obstacle::cylinder(
+                center,
+                rng.uniform_f32(0.03, 0.1),
+                rng.uniform_f32(0.1, 0.4),
+                [1.0, 0.0, 0.0, 0.0],
+            ),
+            _ => Obstacle::sphere(center, rng.uniform_f32(0.03, 0.12)),
         }
         .unwrap();
         let mut trial = scene.clone();
@@ -72,7 +66,7 @@ fn scene(rng: &mut Rng, path: &[[f32; 7]; H]) -> Scene<64> {
 }
 
 fn bench(c: &mut Criterion) {
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     let batch: [[[f32; 7]; H]; BATCH] = core::array::from_fn(|_| trajectory(&mut rng));
     let scene = scene(&mut rng, &batch[0]);
     let mut group = c.benchmark_group("collision");

@@ -5,22 +5,15 @@ use core::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use edmp_core::ik::{IkConfig, solve};
 use edmp_core::kinematics::{CORNERS, CornerGradient, forward};
+use edmp_core::rng::Rng;
 use edmp_core::robot::{BODIES, JOINTS, PANDA};
 use edmp_core::scene::Scene;
 use nalgebra::Vector3;
 
-/// A fixed pseudo-random sequence in [0, 1) (splitmix-style), so the bench inputs are stable.
+/// A fixed pseudo-random sequence in [0, 1), so the bench inputs are stable.
 fn unit_sequence(seed: u64, n: usize) -> Vec<f32> {
-    let mut s = seed;
-    (0..n)
-        .map(|_| {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-        })
-        .collect()
+    let mut rng = Rng::new(seed);
+    (0..n).map(|_| rng.unit_f32()).collect()
 }
 
 fn configurations(n: usize) -> Vec<[f32; JOINTS]> {

@@ -38,23 +38,31 @@ enum Command {
     Render(render::Args),
 }
 
+/// What went wrong, and the exit status it maps to (`spec/formats.md`).
+pub(crate) enum Failure {
+    /// Bad input or I/O: exit 2, nothing written.
+    Input(String),
+    /// Ran, but found no path: exit 1.
+    NoPath(String),
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Fk(args) => fk::run(&args).map_err(rrt_cmd::Failure::Input),
+        Command::Fk(args) => fk::run(&args).map_err(Failure::Input),
         Command::Rrt(args) => rrt_cmd::run(&args),
-        Command::GenSuite(args) => suite::run(&args).map_err(rrt_cmd::Failure::Input),
-        Command::BenchRrt(args) => bench_rrt::run(&args).map_err(rrt_cmd::Failure::Input),
-        Command::GenData(args) => gen_data::run(&args).map_err(rrt_cmd::Failure::Input),
-        Command::Render(args) => render::run(&args).map_err(rrt_cmd::Failure::Input),
+        Command::GenSuite(args) => suite::run(&args).map_err(Failure::Input),
+        Command::BenchRrt(args) => bench_rrt::run(&args).map_err(Failure::Input),
+        Command::GenData(args) => gen_data::run(&args).map_err(Failure::Input),
+        Command::Render(args) => render::run(&args).map_err(Failure::Input),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(rrt_cmd::Failure::NoPath(message)) => {
+        Err(Failure::NoPath(message)) => {
             eprintln!("edmp-host: {message}");
             ExitCode::from(1)
         }
-        Err(rrt_cmd::Failure::Input(message)) => {
+        Err(Failure::Input(message)) => {
             eprintln!("edmp-host: {message}");
             ExitCode::from(2)
         }

@@ -11,7 +11,7 @@ use core::time::Duration;
 use edmp_core::checker::{CheckConfig, check_state, check_trajectory};
 use edmp_core::kinematics::Joints;
 use edmp_core::rng::Rng;
-use edmp_core::robot::{JOINTS, PANDA};
+use edmp_core::robot::PANDA;
 use edmp_core::scene::Scene;
 use std::time::Instant;
 
@@ -280,8 +280,6 @@ pub(crate) fn plan<const H: usize, const N: usize>(
 pub(crate) fn path_length(waypoints: &[Joints<f32>]) -> f32 {
     waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum()
 }
-
-const _: () = assert!(JOINTS == 7);
 
 #[cfg(test)]
 mod tests {

@@ -1,6 +1,7 @@
 //! `edmp-host rrt`: the RRT-Connect baseline on one `edmp-scene/1` file, written as an
 //! `edmp-plan/1` plan (status "success" only: without a path nothing is written, exit 1).
 
+use crate::Failure;
 use crate::json::{Goal, parse_problem};
 use crate::rrt::{RrtConfig, RrtError, path_length, plan};
 use core::time::Duration;
@@ -25,14 +26,6 @@ pub(crate) struct Args {
     /// Planning time budget in milliseconds.
     #[arg(long, default_value_t = 1000)]
     budget_ms: u64,
-}
-
-/// What went wrong, and the exit status it maps to.
-pub(crate) enum Failure {
-    /// Bad input or I/O: exit 2, nothing written.
-    Input(String),
-    /// Ran, found no path: exit 1, nothing written.
-    NoPath(String),
 }
 
 /// Plans and writes the plan.

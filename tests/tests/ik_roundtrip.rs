@@ -6,26 +6,19 @@
 use edmp_core::checker::{CheckConfig, check_state};
 use edmp_core::ik::{IkConfig, rotation_error, solve};
 use edmp_core::kinematics::forward;
+use edmp_core::rng::Rng;
 use edmp_core::robot::PANDA;
 use edmp_core::scene::Scene;
-
-fn splitmix(state: &mut u64) -> f32 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-}
 
 #[test]
 fn ik_round_trip_on_1000_reachable_poses() {
     let scene = Scene::<1>::new();
     let ready = [0.0f32, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-    let mut state = 42u64;
+    let mut rng = Rng::new(42);
     let (mut tried, mut solved, mut starts) = (0, 0, 0u32);
     while tried < 1000 {
         let q: [f32; 7] = core::array::from_fn(|j| {
-            PANDA.soft_lower[j] + splitmix(&mut state) * (PANDA.soft_upper[j] - PANDA.soft_lower[j])
+            PANDA.soft_lower[j] + rng.unit_f32() * (PANDA.soft_upper[j] - PANDA.soft_lower[j])
         });
         if check_state(&scene, &q, &CheckConfig::default()) != Ok(None) {
             continue; // not a valid robot state, so its pose is not a fair target
