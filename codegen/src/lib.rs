@@ -1,12 +1,13 @@
-//! Build-time generator of edmp-rs: freezes the Panda kinematic chain (and, later, the trained
-//! network) into Rust tables that `edmp-core` includes from `OUT_DIR`.
+//! Build-time generator of edmp-rs: freezes the Panda kinematic chain and the trained,
+//! int8-quantized diffusion network into Rust tables that `edmp-core` includes from `OUT_DIR`.
 //!
-//! `edmp-core/build.rs` calls [`generate_robot`]; the `edmp-codegen` binary prints the same
+//! `edmp-core/build.rs` calls [`generate_robot`] and [`prior::generate_prior`]; the `edmp-codegen` binary prints the same
 //! output for review. Nothing here runs on the target.
 
 pub mod emit;
 pub mod math;
 pub mod mesh;
+pub mod prior;
 pub mod urdf;
 
 use std::path::{Path, PathBuf};

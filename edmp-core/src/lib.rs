@@ -26,6 +26,7 @@ pub mod geometry;
 pub mod gjk;
 pub mod ik;
 pub mod kinematics;
+pub mod prior;
 pub mod rng;
 pub mod robot;
 pub mod scene;

@@ -1,0 +1,234 @@
+//! The diffusion prior over trajectories: the trained int8 UNet ([`predict_noise`]) and the
+//! reverse-diffusion samplers that turn noise into a trajectory between a start and a goal.
+//!
+//! Two samplers share one step interface, so the guided planner can apply its costs between
+//! steps: EDMP's original ancestral sampler (all `STEPS` = 255 steps, noise std β_t, exactly
+//! as shared/notes/edmp-reference.md §1), and DDIM (η = 0) on `K` evenly strided steps, which
+//! trades steps for speed. Both write the start and the goal into the first and last waypoint
+//! after every step.
+
+mod net;
+
+#[allow(missing_docs, unreachable_pub, clippy::unreadable_literal, clippy::excessive_precision)]
+mod generated {
+    use super::net::{Aligned, Conv, ConvBlock, Down, Linear, Net, ResBlock, Up, slice_of};
+    include!(concat!(env!("OUT_DIR"), "/prior.rs"));
+}
+
+pub use generated::{DIMS, LENGTHS, LEVELS, MACS, PARAMETERS, STEPS, WEIGHT_BYTES, WEIGHTS_FNV1A};
+pub use net::{SCRATCH_BYTES, Scratch, TimeEmbedding, Trajectory, predict_noise};
+
+use crate::Error;
+use crate::rng::Rng;
+use crate::robot::JOINTS;
+
+/// Waypoints of a trajectory the prior makes.
+pub const HORIZON: usize = LENGTHS[0];
+
+/// A trajectory of the prior's horizon.
+pub type Path = Trajectory<HORIZON>;
+
+/// The weight blob the build embedded: `include_bytes!` of the codegen output.
+pub fn weight_blob() -> &'static [u8] {
+    generated::WEIGHT_BLOB
+}
+
+/// Whether the embedded weights still hash to the checksum codegen computed (flash check).
+pub fn weights_intact() -> bool {
+    let h = weight_blob()
+        .iter()
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3));
+    h == WEIGHTS_FNV1A
+}
+
+/// How to walk from noise to a trajectory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampler {
+    /// EDMP's ancestral sampler: every step t = 255 … 1,
+    /// x ← (x − β_t/√(1−ᾱ_t)·ε̂)/√α_t + β_t·z (z = 0 at t = 1).
+    Ancestral,
+    /// Deterministic DDIM on `steps` strided steps t_j = T − ⌊j·T/K⌋, j = 0 … K − 1.
+    Ddim {
+        /// K, 1 ..= `STEPS`.
+        steps: u16,
+    },
+}
+
+/// One reverse step: denoise at `t`, land on `prev` (0 is the clean trajectory).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Step {
+    /// The step the network is evaluated at.
+    pub t: u16,
+    /// The step the update lands on.
+    pub prev: u16,
+}
+
+impl Sampler {
+    /// Refuses a DDIM step count outside 1 ..= `STEPS`.
+    pub fn validate(&self) -> Result<(), Error> {
+        match *self {
+            Self::Ancestral => Ok(()),
+            Self::Ddim { steps } if steps >= 1 && usize::from(steps) <= STEPS => Ok(()),
+            Self::Ddim { .. } => Err(Error::BadParameter),
+        }
+    }
+
+    /// Network evaluations per trajectory.
+    pub fn evaluations(&self) -> usize {
+        match *self {
+            Self::Ancestral => STEPS,
+            Self::Ddim { steps } => usize::from(steps),
+        }
+    }
+
+    /// The `j`-th step of the walk (`j < evaluations()`).
+    pub fn step(&self, j: usize) -> Step {
+        let at = |j: usize| -> u16 {
+            let k = self.evaluations();
+            if j >= k { 0 } else { (STEPS - j * STEPS / k) as u16 }
+        };
+        Step { t: at(j), prev: at(j + 1) }
+    }
+
+    /// Moves `x` from step `step.t` to `step.prev` given the network's `eps` (the noise draw,
+    /// ancestral only, comes from `rng`, one normal per entry, waypoint-major). Then re-inpaints.
+    pub fn update(&self, step: Step, x: &mut Path, eps: &Path, rng: &mut Rng, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
+        let i = usize::from(step.t).saturating_sub(1).min(STEPS - 1);
+        match *self {
+            Self::Ancestral => {
+                let (a, c, sigma) = (generated::SQRT_RECIP_ALPHA[i], generated::EPS_COEF[i], generated::BETA[i]);
+                for (xw, ew) in x.iter_mut().zip(eps) {
+                    for (xv, ev) in xw.iter_mut().zip(ew) {
+                        let z = if step.t > 1 { rng.normal_f32() } else { 0.0 };
+                        *xv = a * (*xv - c * ev) + sigma * z;
+                    }
+                }
+            }
+            Self::Ddim { .. } => {
+                let (sa, sn) = (generated::SQRT_ALPHA_BAR[i], generated::SQRT_ONE_MINUS_ALPHA_BAR[i]);
+                let (pa, pn) = match step.prev {
+                    0 => (1.0, 0.0),
+                    p => {
+                        let p = usize::from(p) - 1;
+                        (generated::SQRT_ALPHA_BAR[p], generated::SQRT_ONE_MINUS_ALPHA_BAR[p])
+                    }
+                };
+                for (xw, ew) in x.iter_mut().zip(eps) {
+                    for (xv, ev) in xw.iter_mut().zip(ew) {
+                        let x0 = (*xv - sn * ev) / sa;
+                        *xv = pa * x0 + pn * ev;
+                    }
+                }
+            }
+        }
+        inpaint(x, start, goal);
+    }
+}
+
+/// Writes the start and the goal into the first and last waypoints.
+pub fn inpaint(x: &mut Path, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
+    x[0] = *start;
+    x[HORIZON - 1] = *goal;
+}
+
+/// The sampler's starting point: standard normal entries (waypoint-major), then inpainted.
+pub fn initial_noise(x: &mut Path, rng: &mut Rng, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
+    for v in x.iter_mut().flatten() {
+        *v = rng.normal_f32();
+    }
+    inpaint(x, start, goal);
+}
+
+fn check_joints(q: &[f32; JOINTS]) -> Result<(), Error> {
+    match q.iter().position(|v| !v.is_finite()) {
+        Some(joint) => Err(Error::NonFiniteJoint { joint: joint as u8 }),
+        None => Ok(()),
+    }
+}
+
+/// Unguided sampling of `B` trajectories from `start` to `goal`, all from one `rng` stream
+/// (trajectory 0's noise first). Fixed work: `B × sampler.evaluations()` network forwards.
+pub fn sample<const B: usize>(
+    sampler: Sampler,
+    start: &[f32; JOINTS],
+    goal: &[f32; JOINTS],
+    rng: &mut Rng,
+    scratch: &mut Scratch,
+    out: &mut [Path; B],
+) -> Result<(), Error> {
+    sampler.validate()?;
+    check_joints(start)?;
+    check_joints(goal)?;
+    for x in out.iter_mut() {
+        initial_noise(x, rng, start, goal);
+    }
+    let mut eps = [[0.0f32; JOINTS]; HORIZON];
+    for j in 0..sampler.evaluations() {
+        let step = sampler.step(j);
+        let time = TimeEmbedding::new(step.t)?;
+        for x in out.iter_mut() {
+            predict_noise(x, &time, scratch, &mut eps)?;
+            sampler.update(step, x, &eps, rng, start, goal);
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ddim_strides_cover_the_schedule() {
+        let s = Sampler::Ddim { steps: 10 };
+        assert_eq!(s.step(0), Step { t: 255, prev: 230 });
+        assert_eq!(s.step(9), Step { t: 26, prev: 0 });
+        let all = Sampler::Ddim { steps: 255 };
+        assert!((0..255).all(|j| all.step(j).t == 255 - j as u16));
+        assert_eq!(Sampler::Ancestral.step(254), Step { t: 1, prev: 0 });
+        assert_eq!(Sampler::Ddim { steps: 0 }.validate(), Err(Error::BadParameter));
+        assert_eq!(Sampler::Ddim { steps: 256 }.validate(), Err(Error::BadParameter));
+    }
+
+    #[test]
+    fn embedded_weights_match_their_checksum() {
+        assert!(weights_intact());
+        assert_eq!(weight_blob().len(), WEIGHT_BYTES);
+        assert_eq!(weight_blob().as_ptr() as usize % 16, 0);
+    }
+
+    #[test]
+    fn time_embedding_refuses_steps_outside_the_schedule() {
+        assert_eq!(TimeEmbedding::new(0), Err(Error::BadParameter));
+        assert_eq!(TimeEmbedding::new(STEPS as u16 + 1), Err(Error::BadParameter));
+        assert!(TimeEmbedding::new(1).is_ok());
+    }
+
+    #[test]
+    fn noise_prediction_refuses_nan_and_is_deterministic() {
+        let mut scratch = Scratch::new();
+        let time = TimeEmbedding::new(100).unwrap();
+        let mut x = [[0.1f32; JOINTS]; HORIZON];
+        let mut rng = Rng::new(3);
+        initial_noise(&mut x, &mut rng, &[0.0; JOINTS], &[0.5; JOINTS]);
+        let (mut a, mut b) = ([[0.0f32; JOINTS]; HORIZON], [[0.0f32; JOINTS]; HORIZON]);
+        predict_noise(&x, &time, &mut scratch, &mut a).unwrap();
+        predict_noise(&x, &time, &mut Scratch::new(), &mut b).unwrap();
+        assert_eq!(a, b);
+        x[7][3] = f32::NAN;
+        assert_eq!(predict_noise(&x, &time, &mut scratch, &mut a), Err(Error::NonFiniteJoint { joint: 3 }));
+    }
+
+    #[test]
+    fn samples_keep_start_and_goal_and_stay_finite() {
+        let (start, goal) = ([0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7], [0.8, 0.2, 0.1, -1.5, 0.3, 1.8, 0.2]);
+        let mut out = [[[0.0f32; JOINTS]; HORIZON]; 2];
+        let mut rng = Rng::new(9);
+        sample(Sampler::Ddim { steps: 5 }, &start, &goal, &mut rng, &mut Scratch::new(), &mut out).unwrap();
+        for x in &out {
+            assert_eq!(x[0], start);
+            assert_eq!(x[HORIZON - 1], goal);
+            assert!(x.iter().flatten().all(|v| v.is_finite()));
+        }
+    }
+}

@@ -1,0 +1,95 @@
+"""Write the parity fixture the Rust int8 network is tested against.
+
+    python3 weights/prior/parity.py --data data.npy
+
+For fixed inputs (several t; x_t made from held-out trajectories as in training, and pure noise)
+it records the float model's epsilon and the fake-quantized model's (int8 weights * scale, float
+activations: what edmp-core computes) to `tests/fixtures/prior_parity.json`, and prints the
+int8-vs-float error.
+"""
+
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+import torch
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from model import T, TemporalUNet, fake_quantized, schedule  # noqa: E402
+
+
+def load(directory):
+    from safetensors.torch import load_file
+
+    with open(os.path.join(directory, "prior.json")) as f:
+        config = json.load(f)
+    model = TemporalUNet(tuple(config["dims"]), config["time_dim"], config["time_hidden"])
+    model.load_state_dict(load_file(os.path.join(directory, "prior.safetensors")))
+    model.eval()
+    return model
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--data", required=True, help="the gen-data .npy the prior was trained on")
+    ap.add_argument("--weights", default=HERE)
+    ap.add_argument("--out", default=os.path.join(HERE, "..", "..", "tests", "fixtures", "prior_parity.json"))
+    ap.add_argument("--seed", type=int, default=20261124)
+    args = ap.parse_args()
+
+    torch.manual_seed(args.seed)
+    model = load(args.weights)
+    fq = fake_quantized(model)
+    data = np.load(args.data, mmap_mode="r")
+    _, _, alpha_bars = schedule()
+
+    steps = [1, 2, 10, 64, 128, 200, 254, 255]
+    cases = []
+    # Held-out trajectories (the trainer holds out the last 2000).
+    pick = np.random.default_rng(args.seed).choice(np.arange(len(data) - 2000, len(data)), len(steps), replace=False)
+    for i, t in enumerate(steps):
+        x0 = torch.from_numpy(np.array(data[pick[i]]).T.copy()).float()[None]
+        eps = torch.randn(x0.shape)
+        ab = alpha_bars[t - 1].float()
+        xt = ab.sqrt() * x0 + (1 - ab).sqrt() * eps
+        xt[:, :, 0], xt[:, :, -1] = x0[:, :, 0], x0[:, :, -1]
+        cases.append((t, xt))
+    for t in (255, 128, 3):
+        xt = torch.randn(1, 7, 50)
+        cases.append((t, xt))
+
+    out = {"seed": args.seed, "note": "x and eps are waypoint-major (50 x 7); regenerate with weights/prior/parity.py", "cases": []}
+    worst_q, worst_scale = 0.0, 0.0
+    with torch.no_grad():
+        for t, xt in cases:
+            tt = torch.tensor([t])
+            ef = model(xt, tt)[0]
+            eq = fq(xt, tt)[0]
+            worst_q = max(worst_q, (eq - ef).abs().max().item())
+            worst_scale = max(worst_scale, ef.abs().max().item())
+            out["cases"].append(
+                {
+                    "t": t,
+                    "x": xt[0].T.tolist(),
+                    "eps_float": ef.T.tolist(),
+                    "eps_fake_quant": eq.T.tolist(),
+                }
+            )
+    rel = [
+        np.abs(np.array(c["eps_fake_quant"]) - np.array(c["eps_float"])).max() / np.abs(np.array(c["eps_float"])).max()
+        for c in out["cases"]
+    ]
+    out["int8_vs_float_max_abs"] = worst_q
+    out["int8_vs_float_max_relative"] = float(max(rel))
+    with open(args.out, "w") as f:
+        json.dump(out, f)
+        f.write("\n")
+    print(f"{len(cases)} cases -> {os.path.relpath(args.out)}; int8 vs float: max |diff| {worst_q:.3e}, "
+          f"max relative to the case's max |eps| {max(rel):.3e} (T = {T})")
+
+
+if __name__ == "__main__":
+    main()
