@@ -11,6 +11,7 @@ mod json;
 mod render;
 mod rrt;
 mod rrt_cmd;
+mod sample;
 mod scenes;
 mod suite;
 
@@ -36,6 +37,8 @@ enum Command {
     GenData(gen_data::Args),
     /// Draw a scene (and optionally a plan) as a PNG: top and side views.
     Render(render::Args),
+    /// Measure the unguided diffusion prior: roughness, joint limits, self-collision, time.
+    Sample(sample::Args),
 }
 
 /// What went wrong, and the exit status it maps to (`spec/formats.md`).
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::BenchRrt(args) => bench_rrt::run(&args).map_err(Failure::Input),
         Command::GenData(args) => gen_data::run(&args).map_err(Failure::Input),
         Command::Render(args) => render::run(&args).map_err(Failure::Input),
+        Command::Sample(args) => sample::run(&args).map_err(Failure::Input),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -29,14 +29,15 @@ const X_RANGE: [f32; 2] = [-0.5, 1.4];
 const TOP_RANGE: [f32; 2] = [-0.95, 0.95];
 const SIDE_RANGE: [f32; 2] = [-0.15, 1.75];
 
-struct Canvas {
+/// An RGB raster with alpha-blended convex fills (no anti-aliasing).
+pub(crate) struct Canvas {
     width: usize,
     height: usize,
     pixels: Vec<[f32; 3]>,
 }
 
 impl Canvas {
-    fn new(width: usize, height: usize) -> Self {
+    pub(crate) fn new(width: usize, height: usize) -> Self {
         Self {
             width,
             height,
@@ -88,7 +89,21 @@ impl Canvas {
         }
     }
 
-    fn png(&self, path: &std::path::Path) -> Result<(), String> {
+    /// A straight segment `width` pixels wide.
+    pub(crate) fn line(&mut self, a: [f32; 2], b: [f32; 2], width: f32, color: [f32; 3], alpha: f32) {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len = (dx * dx + dy * dy).sqrt().max(1e-6);
+        let (nx, ny) = (-dy / len * width * 0.5, dx / len * width * 0.5);
+        let quad = [
+            [a[0] + nx, a[1] + ny],
+            [b[0] + nx, b[1] + ny],
+            [b[0] - nx, b[1] - ny],
+            [a[0] - nx, a[1] - ny],
+        ];
+        self.fill(&quad, color, alpha);
+    }
+
+    pub(crate) fn png(&self, path: &std::path::Path) -> Result<(), String> {
         let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), self.width as u32, self.height as u32);
         encoder.set_color(png::ColorType::Rgb);

@@ -39,14 +39,15 @@ fn int8_network_matches_the_fake_quantized_pytorch_model() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/prior_parity.json");
     let fixture: Fixture = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     assert!(fixture.cases.len() >= 8);
-    let mut scratch = Scratch::new();
+    let mut scratch = Scratch::<1>::new();
     let (mut worst_fq, mut worst_float) = (0.0f64, 0.0f64);
     for case in &fixture.cases {
         assert_eq!(case.x.len(), HORIZON);
         let x: Path = case.x.clone().try_into().unwrap();
         let time = TimeEmbedding::new(case.t).unwrap();
-        let mut eps: Path = [[0.0; 7]; HORIZON];
-        predict_noise(&x, &time, &mut scratch, &mut eps).unwrap();
+        let mut eps = [[[0.0; 7]; HORIZON]];
+        predict_noise(&[x], &time, &mut scratch, &mut eps).unwrap();
+        let eps = eps[0];
         let (fq, float) = (worst(&eps, &case.eps_fake_quant), worst(&eps, &case.eps_float));
         assert!(
             fq <= PARITY_REL_TOL,

@@ -2,8 +2,9 @@
 
 The layout follows the original (shared/notes/edmp-reference.md §2): Conv1d(k=5) -> GroupNorm(8)
 -> Mish blocks, residual blocks with a sinusoidal time embedding, stride-2 downsampling, transposed-
-conv upsampling with a crop back to the skip's length (50 -> 25 -> 13 and back), no attention, and
-the original's unused full-resolution skip. Only the channel widths differ.
+conv upsampling with a crop back to the skip's length (50 -> 25 -> 13 and back), no attention.
+Differences: the channel widths, and (`top_skip`, default on) the first level's full-resolution
+skip, which the original computes and never uses, is concatenated before the final block.
 
 Everything `edmp-core` needs to run this network is in `config()`; the Rust side reads the same
 parameter names from the safetensors file, so keep names and shapes stable.
@@ -70,9 +71,10 @@ class ResBlock(nn.Module):
 class TemporalUNet(nn.Module):
     """epsilon-prediction network: (B, 7, 50) noisy trajectory and step t -> (B, 7, 50) noise."""
 
-    def __init__(self, dims=(16, 32, 64), time_dim=32, time_hidden=128):
+    def __init__(self, dims=(16, 32, 64), time_dim=32, time_hidden=128, top_skip=True):
         super().__init__()
         self.dims = tuple(dims)
+        self.top_skip = top_skip
         self.time_dim = time_dim
         self.time_hidden = time_hidden
         self.time_in = nn.Linear(time_dim, time_hidden)
@@ -99,7 +101,7 @@ class TemporalUNet(nn.Module):
             level.res1 = ResBlock(din, din, time_dim)
             level.sample = nn.ConvTranspose1d(din, din, 4, stride=2, padding=1)
             self.up.append(level)
-        self.final = ConvBlock(self.dims[0], self.dims[0])
+        self.final = ConvBlock((2 if top_skip else 1) * self.dims[0], self.dims[0])
         self.out = nn.Conv1d(self.dims[0], JOINTS, 1)
 
     def lengths(self):
@@ -127,7 +129,10 @@ class TemporalUNet(nn.Module):
             x = level.res1(x, temb)
             x = level.sample(x)
             x = x[:, :, : lengths[len(self.dims) - 2 - j]]
-        # As the original: the full-resolution skip of the first level is never consumed.
+        if self.top_skip:
+            # Our fix: the original never consumes the first level's full-resolution skip, so
+            # waypoint-scale detail (the white part of the noise) must survive a 2x downsampling.
+            x = torch.cat([x, skips.pop()], dim=1)
         return self.out(self.final(x))
 
     def config(self):
@@ -140,6 +145,7 @@ class TemporalUNet(nn.Module):
             "horizon": HORIZON,
             "joints": JOINTS,
             "lengths": self.lengths(),
+            "top_skip": self.top_skip,
         }
 
     def macs(self):

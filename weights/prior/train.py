@@ -30,6 +30,7 @@ def main():
     ap.add_argument("--data", required=True, help="(N, 50, 7) float32 .npy from edmp-host gen-data")
     ap.add_argument("--out", default=os.path.dirname(os.path.abspath(__file__)))
     ap.add_argument("--dims", default="16,32,64")
+    ap.add_argument("--no-top-skip", action="store_true", help="leave the full-resolution skip unused, as the original")
     ap.add_argument("--steps", type=int, default=24000)
     ap.add_argument("--batch", type=int, default=256)
     ap.add_argument("--lr", type=float, default=1e-3)
@@ -52,8 +53,8 @@ def main():
     train, held = x_all[: -args.holdout], x_all[-args.holdout :]
 
     dims = tuple(int(d) for d in args.dims.split(","))
-    model = TemporalUNet(dims).to(device)
-    ema = TemporalUNet(dims).to(device)
+    model = TemporalUNet(dims, top_skip=not args.no_top_skip).to(device)
+    ema = TemporalUNet(dims, top_skip=not args.no_top_skip).to(device)
     ema.load_state_dict(model.state_dict())
     for p in ema.parameters():
         p.requires_grad_(False)

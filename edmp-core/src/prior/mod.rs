@@ -9,14 +9,19 @@
 
 mod net;
 
-#[allow(missing_docs, unreachable_pub, clippy::unreadable_literal, clippy::excessive_precision)]
+#[allow(
+    missing_docs,
+    unreachable_pub,
+    clippy::unreadable_literal,
+    clippy::excessive_precision
+)]
 mod generated {
     use super::net::{Aligned, Conv, ConvBlock, Down, Linear, Net, ResBlock, Up, slice_of};
     include!(concat!(env!("OUT_DIR"), "/prior.rs"));
 }
 
 pub use generated::{DIMS, LENGTHS, LEVELS, MACS, PARAMETERS, STEPS, WEIGHT_BYTES, WEIGHTS_FNV1A};
-pub use net::{SCRATCH_BYTES, Scratch, TimeEmbedding, Trajectory, predict_noise};
+pub use net::{Scratch, TimeEmbedding, Trajectory, predict_noise};
 
 use crate::Error;
 use crate::rng::Rng;
@@ -35,9 +40,9 @@ pub fn weight_blob() -> &'static [u8] {
 
 /// Whether the embedded weights still hash to the checksum codegen computed (flash check).
 pub fn weights_intact() -> bool {
-    let h = weight_blob()
-        .iter()
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3));
+    let h = weight_blob().iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3)
+    });
     h == WEIGHTS_FNV1A
 }
 
@@ -87,16 +92,31 @@ impl Sampler {
             let k = self.evaluations();
             if j >= k { 0 } else { (STEPS - j * STEPS / k) as u16 }
         };
-        Step { t: at(j), prev: at(j + 1) }
+        Step {
+            t: at(j),
+            prev: at(j + 1),
+        }
     }
 
     /// Moves `x` from step `step.t` to `step.prev` given the network's `eps` (the noise draw,
     /// ancestral only, comes from `rng`, one normal per entry, waypoint-major). Then re-inpaints.
-    pub fn update(&self, step: Step, x: &mut Path, eps: &Path, rng: &mut Rng, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
+    pub fn update(
+        &self,
+        step: Step,
+        x: &mut Path,
+        eps: &Path,
+        rng: &mut Rng,
+        start: &[f32; JOINTS],
+        goal: &[f32; JOINTS],
+    ) {
         let i = usize::from(step.t).saturating_sub(1).min(STEPS - 1);
         match *self {
             Self::Ancestral => {
-                let (a, c, sigma) = (generated::SQRT_RECIP_ALPHA[i], generated::EPS_COEF[i], generated::BETA[i]);
+                let (a, c, sigma) = (
+                    generated::SQRT_RECIP_ALPHA[i],
+                    generated::EPS_COEF[i],
+                    generated::BETA[i],
+                );
                 for (xw, ew) in x.iter_mut().zip(eps) {
                     for (xv, ev) in xw.iter_mut().zip(ew) {
                         let z = if step.t > 1 { rng.normal_f32() } else { 0.0 };
@@ -147,13 +167,14 @@ fn check_joints(q: &[f32; JOINTS]) -> Result<(), Error> {
 }
 
 /// Unguided sampling of `B` trajectories from `start` to `goal`, all from one `rng` stream
-/// (trajectory 0's noise first). Fixed work: `B × sampler.evaluations()` network forwards.
+/// (trajectory 0's noise first, then 1's, at every step). Fixed work: `sampler.evaluations()`
+/// batched network forwards.
 pub fn sample<const B: usize>(
     sampler: Sampler,
     start: &[f32; JOINTS],
     goal: &[f32; JOINTS],
     rng: &mut Rng,
-    scratch: &mut Scratch,
+    scratch: &mut Scratch<B>,
     out: &mut [Path; B],
 ) -> Result<(), Error> {
     sampler.validate()?;
@@ -162,13 +183,13 @@ pub fn sample<const B: usize>(
     for x in out.iter_mut() {
         initial_noise(x, rng, start, goal);
     }
-    let mut eps = [[0.0f32; JOINTS]; HORIZON];
+    let mut eps = [[[0.0f32; JOINTS]; HORIZON]; B];
     for j in 0..sampler.evaluations() {
         let step = sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
-        for x in out.iter_mut() {
-            predict_noise(x, &time, scratch, &mut eps)?;
-            sampler.update(step, x, &eps, rng, start, goal);
+        predict_noise(out, &time, scratch, &mut eps)?;
+        for (x, e) in out.iter_mut().zip(&eps) {
+            sampler.update(step, x, e, rng, start, goal);
         }
     }
     Ok(())
@@ -205,26 +226,42 @@ mod tests {
     }
 
     #[test]
-    fn noise_prediction_refuses_nan_and_is_deterministic() {
-        let mut scratch = Scratch::new();
+    fn noise_prediction_refuses_nan_and_does_not_depend_on_the_batch() {
         let time = TimeEmbedding::new(100).unwrap();
-        let mut x = [[0.1f32; JOINTS]; HORIZON];
         let mut rng = Rng::new(3);
-        initial_noise(&mut x, &mut rng, &[0.0; JOINTS], &[0.5; JOINTS]);
-        let (mut a, mut b) = ([[0.0f32; JOINTS]; HORIZON], [[0.0f32; JOINTS]; HORIZON]);
-        predict_noise(&x, &time, &mut scratch, &mut a).unwrap();
-        predict_noise(&x, &time, &mut Scratch::new(), &mut b).unwrap();
-        assert_eq!(a, b);
-        x[7][3] = f32::NAN;
-        assert_eq!(predict_noise(&x, &time, &mut scratch, &mut a), Err(Error::NonFiniteJoint { joint: 3 }));
+        let mut x = [[[0.0f32; JOINTS]; HORIZON]; 3];
+        for x in &mut x {
+            initial_noise(x, &mut rng, &[0.0; JOINTS], &[0.5; JOINTS]);
+        }
+        let mut batch = [[[0.0f32; JOINTS]; HORIZON]; 3];
+        predict_noise(&x, &time, &mut std::boxed::Box::new(Scratch::new()), &mut batch).unwrap();
+        for (xi, bi) in x.iter().zip(&batch) {
+            let mut one = [[[0.0f32; JOINTS]; HORIZON]; 1];
+            predict_noise(&[*xi], &time, &mut Scratch::new(), &mut one).unwrap();
+            assert_eq!(&one[0], bi);
+        }
+        x[1][7][3] = f32::NAN;
+        let got = predict_noise(&x, &time, &mut std::boxed::Box::new(Scratch::new()), &mut batch);
+        assert_eq!(got, Err(Error::NonFiniteJoint { joint: 3 }));
     }
 
     #[test]
     fn samples_keep_start_and_goal_and_stay_finite() {
-        let (start, goal) = ([0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7], [0.8, 0.2, 0.1, -1.5, 0.3, 1.8, 0.2]);
+        let (start, goal) = (
+            [0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
+            [0.8, 0.2, 0.1, -1.5, 0.3, 1.8, 0.2],
+        );
         let mut out = [[[0.0f32; JOINTS]; HORIZON]; 2];
         let mut rng = Rng::new(9);
-        sample(Sampler::Ddim { steps: 5 }, &start, &goal, &mut rng, &mut Scratch::new(), &mut out).unwrap();
+        sample(
+            Sampler::Ddim { steps: 5 },
+            &start,
+            &goal,
+            &mut rng,
+            &mut std::boxed::Box::new(Scratch::new()),
+            &mut out,
+        )
+        .unwrap();
         for x in &out {
             assert_eq!(x[0], start);
             assert_eq!(x[HORIZON - 1], goal);

@@ -1,4 +1,4 @@
-//! The int8 temporal UNet: ε̂ = net(x_t, t) for one trajectory.
+//! The int8 temporal UNet: ε̂ = net(x_t, t) for a batch of trajectories.
 //!
 //! Weights are int8 with one float scale per output channel (frozen by `edmp-codegen` from
 //! `weights/prior/`); activations stay f32. A convolution accumulates `Σ w_int · x` in f32 and
@@ -6,19 +6,27 @@
 //! to f32 rounding. The accumulation order is fixed (input channel, then tap, then position),
 //! never fused into FMA, so every target gives the same bits.
 //!
-//! Activations are channel-major rows of `len + 2·PAD` floats whose pads are zero: the
-//! "same" convolution reads past the ends without branches.
+//! A batch runs together: activations are channel-major rows holding every trajectory's
+//! segment (data plus zero pads) side by side, so a "same" convolution sweeps a whole row in
+//! register tiles of 4 channels × 8 positions without branches, and only the row's end wastes
+//! work.
 
-use super::generated::{ACTIVATION_FLOATS, DIMS, GROUPS, KERNEL, LENGTHS, LEVELS, NET, TIME_DIM, TIME_HIDDEN};
-use crate::robot::JOINTS;
+use super::generated::{DIMS, GROUPS, KERNEL, LENGTHS, LEVELS, NET, TIME_DIM, TIME_HIDDEN, TOP_SKIP};
 use crate::Error;
+use crate::robot::JOINTS;
 
 /// Zero columns on each side of an activation row.
 const PAD: usize = KERNEL / 2;
 /// The widest level.
 const MAX_WIDTH: usize = max_of(&DIMS);
-/// Floats the kept skip connections need (levels 1.., the first level's skip is never used).
+/// Floats per trajectory of the kept skip connections (levels 1.., and the first level's when
+/// the network reads it: `TOP_SKIP`; the original never does).
 const SKIP_FLOATS: usize = skip_floats();
+
+/// Whether level `i`'s output is kept for the way up.
+const fn keeps_skip(i: usize) -> bool {
+    i >= 1 || TOP_SKIP
+}
 
 const fn max_of(v: &[usize]) -> usize {
     let mut m = 0;
@@ -34,16 +42,58 @@ const fn max_of(v: &[usize]) -> usize {
 
 const fn skip_floats() -> usize {
     let mut total = 0;
-    let mut i = 1;
+    let mut i = 0;
     while i < LEVELS {
-        total += DIMS[i] * (LENGTHS[i] + 2 * PAD);
+        if keeps_skip(i) {
+            total += DIMS[i] * (segment(LENGTHS[i]) + TILE);
+        }
         i += 1;
     }
     total
 }
 
-const fn stride(len: usize) -> usize {
+/// Floats one trajectory occupies in a row: its data with `PAD` zeros on each side.
+const fn segment(len: usize) -> usize {
     len + 2 * PAD
+}
+
+/// Floats per trajectory of the widest activation any stage holds (an up level's concatenated
+/// input), with room for a tile's overrun at the end of each row.
+const ACTIVATION_FLOATS: usize = activation_floats();
+
+const fn activation_floats() -> usize {
+    let mut m = JOINTS * (segment(LENGTHS[0]) + TILE);
+    let mut i = 0;
+    while i < LEVELS {
+        let f = 2 * DIMS[i] * (segment(LENGTHS[i]) + TILE);
+        if f > m {
+            m = f;
+        }
+        i += 1;
+    }
+    m
+}
+
+/// Where a batch's activation lives: channel-major rows, each row the `batch` trajectories'
+/// segments side by side, then `TILE` zeros so a tile never reads past its row. Pads are zero.
+#[derive(Clone, Copy)]
+struct Layout {
+    batch: usize,
+    len: usize,
+}
+
+impl Layout {
+    const fn seg(self) -> usize {
+        segment(self.len)
+    }
+    /// Floats per channel row.
+    const fn row(self) -> usize {
+        self.batch * self.seg() + TILE
+    }
+    /// Index of position `l` of trajectory `b` in channel `c`.
+    const fn at(self, c: usize, b: usize, l: usize) -> usize {
+        c * self.row() + b * self.seg() + PAD + l
+    }
 }
 
 /// Keeps the weight blob at a 16-byte boundary (SIMD loads on the target).
@@ -156,130 +206,189 @@ impl TimeEmbedding {
     }
 }
 
-/// Working memory of one forward, sized at compile time from the generated shapes.
+/// Working memory of one forward of `B` trajectories, sized at compile time from the
+/// generated shapes.
 #[derive(Clone)]
-pub struct Scratch {
-    bufs: [[f32; ACTIVATION_FLOATS]; 3],
-    skips: [f32; SKIP_FLOATS],
+pub struct Scratch<const B: usize> {
+    bufs: [[[f32; ACTIVATION_FLOATS]; B]; 3],
+    skips: [[f32; SKIP_FLOATS]; B],
+    weights: WeightTile,
 }
 
-impl core::fmt::Debug for Scratch {
+impl<const B: usize> core::fmt::Debug for Scratch<B> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "Scratch({SCRATCH_BYTES} bytes)")
+        write!(f, "Scratch<{B}>({} bytes)", Self::BYTES)
     }
 }
 
-impl Default for Scratch {
+impl<const B: usize> Default for Scratch<B> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl Scratch {
+impl<const B: usize> Scratch<B> {
+    /// Bytes of this scratch: the network's whole working memory for `B` trajectories.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
     /// Zeroed scratch (`const`: it can live in a `static`).
     pub const fn new() -> Self {
-        Self { bufs: [[0.0; ACTIVATION_FLOATS]; 3], skips: [0.0; SKIP_FLOATS] }
+        Self {
+            bufs: [[[0.0; ACTIVATION_FLOATS]; B]; 3],
+            skips: [[0.0; SKIP_FLOATS]; B],
+            weights: [0.0; MAX_TAPS * TILE_CHANNELS],
+        }
     }
 }
 
-/// Bytes of [`Scratch`]: the network's whole working memory.
-pub const SCRATCH_BYTES: usize = core::mem::size_of::<Scratch>();
-
-/// Predicts the noise in `x` (horizon `LENGTHS[0]`) at the step `time` was made for.
+/// Predicts the noise in each of the `B` trajectories of `x` (horizon `LENGTHS[0]`) at the
+/// step `time` was made for. Each trajectory's result is independent of the others in the
+/// batch and of `B`, bit for bit.
 ///
 /// Refuses non-finite input; an output that overflowed is [`Error::Overflow`].
-pub fn predict_noise(
-    x: &Trajectory<{ LENGTHS[0] }>,
+pub fn predict_noise<const B: usize>(
+    x: &[Trajectory<{ LENGTHS[0] }>; B],
     time: &TimeEmbedding,
-    scratch: &mut Scratch,
-    eps: &mut Trajectory<{ LENGTHS[0] }>,
+    scratch: &mut Scratch<B>,
+    eps: &mut [Trajectory<{ LENGTHS[0] }>; B],
 ) -> Result<(), Error> {
-    for waypoint in x {
+    for waypoint in x.iter().flatten() {
         if let Some(joint) = waypoint.iter().position(|v| !v.is_finite()) {
             return Err(Error::NonFiniteJoint { joint: joint as u8 });
         }
     }
     let temb = &time.features;
-    let Scratch { bufs, skips } = scratch;
+    let Scratch {
+        bufs,
+        skips,
+        weights: wbuf,
+    } = scratch;
     let [b0, b1, b2] = bufs;
-    let (mut x_buf, h_buf, mut y_buf) = (b0, b1, b2);
+    let (mut x_buf, h_buf, mut y_buf) = (b0.as_flattened_mut(), b1.as_flattened_mut(), b2.as_flattened_mut());
+    let skips = skips.as_flattened_mut();
 
     // Input: channels first, zero pads.
-    let len0 = LENGTHS[0];
-    let s0 = stride(len0);
-    x_buf[..JOINTS * s0].fill(0.0);
-    for (l, waypoint) in x.iter().enumerate() {
-        for (j, v) in waypoint.iter().enumerate() {
-            x_buf[j * s0 + PAD + l] = *v;
+    let top = Layout {
+        batch: B,
+        len: LENGTHS[0],
+    };
+    x_buf[..JOINTS * top.row()].fill(0.0);
+    for (b, trajectory) in x.iter().enumerate() {
+        for (l, waypoint) in trajectory.iter().enumerate() {
+            for (j, v) in waypoint.iter().enumerate() {
+                x_buf[top.at(j, b, l)] = *v;
+            }
         }
     }
 
     let mut skip_offset = 0;
     let mut channels = JOINTS;
     for (i, level) in NET.down.iter().enumerate() {
-        let len = LENGTHS[i];
-        res_block(&level.res0, x_buf, len, temb, h_buf, y_buf);
+        let lay = Layout {
+            batch: B,
+            len: LENGTHS[i],
+        };
+        res_block(&level.res0, x_buf, lay, temb, h_buf, y_buf, wbuf);
         core::mem::swap(&mut x_buf, &mut y_buf);
-        res_block(&level.res1, x_buf, len, temb, h_buf, y_buf);
+        res_block(&level.res1, x_buf, lay, temb, h_buf, y_buf, wbuf);
         core::mem::swap(&mut x_buf, &mut y_buf);
         channels = DIMS[i];
-        if i >= 1 {
-            let n = channels * stride(len);
+        if keeps_skip(i) {
+            let n = channels * lay.row();
             skips[skip_offset..skip_offset + n].copy_from_slice(&x_buf[..n]);
             skip_offset += n;
         }
         if let Some(sample) = &level.sample {
-            conv_down(sample, x_buf, len, y_buf, LENGTHS[i + 1]);
+            conv_down(
+                sample,
+                x_buf,
+                lay,
+                y_buf,
+                Layout {
+                    batch: B,
+                    len: LENGTHS[i + 1],
+                },
+            );
             core::mem::swap(&mut x_buf, &mut y_buf);
         }
     }
-    let deepest = LENGTHS[LEVELS - 1];
-    res_block(&NET.mid0, x_buf, deepest, temb, h_buf, y_buf);
+    let deepest = Layout {
+        batch: B,
+        len: LENGTHS[LEVELS - 1],
+    };
+    res_block(&NET.mid0, x_buf, deepest, temb, h_buf, y_buf, wbuf);
     core::mem::swap(&mut x_buf, &mut y_buf);
-    res_block(&NET.mid1, x_buf, deepest, temb, h_buf, y_buf);
+    res_block(&NET.mid1, x_buf, deepest, temb, h_buf, y_buf, wbuf);
     core::mem::swap(&mut x_buf, &mut y_buf);
 
     for (j, level) in NET.up.iter().enumerate() {
         let i = LEVELS - 1 - j;
-        let len = LENGTHS[i];
+        let lay = Layout {
+            batch: B,
+            len: LENGTHS[i],
+        };
         // Concatenate [x, skip_i] on channels: the skip's rows follow x's.
-        let n = channels * stride(len);
+        let n = channels * lay.row();
         skip_offset -= n;
         x_buf[n..2 * n].copy_from_slice(&skips[skip_offset..skip_offset + n]);
-        res_block(&level.res0, x_buf, len, temb, h_buf, y_buf);
+        res_block(&level.res0, x_buf, lay, temb, h_buf, y_buf, wbuf);
         core::mem::swap(&mut x_buf, &mut y_buf);
-        res_block(&level.res1, x_buf, len, temb, h_buf, y_buf);
+        res_block(&level.res1, x_buf, lay, temb, h_buf, y_buf, wbuf);
         core::mem::swap(&mut x_buf, &mut y_buf);
-        conv_up(&level.sample, x_buf, len, y_buf, LENGTHS[i - 1]);
+        conv_up(
+            &level.sample,
+            x_buf,
+            lay,
+            y_buf,
+            Layout {
+                batch: B,
+                len: LENGTHS[i - 1],
+            },
+        );
         core::mem::swap(&mut x_buf, &mut y_buf);
         channels = level.sample.cout;
     }
-    conv_block(&NET.final_block, x_buf, len0, y_buf);
-    conv_same(&NET.out, y_buf, len0, h_buf, Accumulate::Overwrite);
-    for (l, waypoint) in eps.iter_mut().enumerate() {
-        for (j, v) in waypoint.iter_mut().enumerate() {
-            *v = h_buf[j * s0 + PAD + l];
+    if TOP_SKIP {
+        let n = channels * top.row();
+        x_buf[n..2 * n].copy_from_slice(&skips[..n]);
+    }
+    conv_block(&NET.final_block, x_buf, top, y_buf, wbuf);
+    conv_same(&NET.out, y_buf, top, h_buf, Accumulate::Overwrite, wbuf);
+    for (b, trajectory) in eps.iter_mut().enumerate() {
+        for (l, waypoint) in trajectory.iter_mut().enumerate() {
+            for (j, v) in waypoint.iter_mut().enumerate() {
+                *v = h_buf[top.at(j, b, l)];
+            }
         }
     }
-    if eps.iter().flatten().all(|v| v.is_finite()) { Ok(()) } else { Err(Error::Overflow) }
+    if eps.iter().flatten().flatten().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::Overflow)
+    }
 }
 
 /// Mish, x·tanh(softplus(x)), with one `expf`: tanh(ln(1 + u)) = n / (n + 2), n = u(u + 2).
 /// Above 20 it is x (PyTorch's softplus threshold), so `u²` never overflows.
 #[inline]
 fn mish(x: f32) -> f32 {
-    if x > 20.0 {
-        return x;
-    }
-    let u = libm::expf(x);
+    mish_from_exp(x, libm::expf(x.min(20.0)))
+}
+
+/// Mish of `x` given `u = expf(min(x, 20))`.
+#[inline(always)]
+fn mish_from_exp(x: f32, u: f32) -> f32 {
     let n = u * (u + 2.0);
-    x * n / (n + 2.0)
+    if x > 20.0 { x } else { x * n / (n + 2.0) }
 }
 
 fn linear(layer: &Linear, input: &[f32], out: &mut [f32]) {
     for (o, y) in out.iter_mut().enumerate().take(layer.fout) {
         let row = &layer.weights[o * layer.fin..(o + 1) * layer.fin];
-        let acc = row.iter().zip(input).fold(0.0f32, |acc, (w, x)| acc + f32::from(*w as i8) * x);
+        let acc = row
+            .iter()
+            .zip(input)
+            .fold(0.0f32, |acc, (w, x)| acc + f32::from(*w as i8) * x);
         *y = acc * layer.scale[o] + layer.bias[o];
     }
 }
@@ -290,152 +399,280 @@ enum Accumulate {
     Add,
 }
 
-/// "Same" convolution (odd k ≤ 2·PAD + 1, stride 1) on padded rows; writes zero pads.
-fn conv_same(conv: &Conv, input: &[f32], len: usize, out: &mut [f32], mode: Accumulate) {
-    let s = stride(len);
-    let shift = PAD - conv.k / 2;
-    let mut acc = [0.0f32; LENGTHS[0]];
-    let acc = &mut acc[..len];
-    for co in 0..conv.cout {
-        acc.fill(0.0);
-        for ci in 0..conv.cin {
-            let row = &input[ci * s..(ci + 1) * s];
-            let taps = &conv.weights[(co * conv.cin + ci) * conv.k..(co * conv.cin + ci + 1) * conv.k];
-            for (kk, w) in taps.iter().enumerate() {
-                let w = f32::from(*w as i8);
-                let x = &row[shift + kk..shift + kk + len];
-                for (a, v) in acc.iter_mut().zip(x) {
-                    *a += w * v;
-                }
-            }
-        }
-        let (scale, bias) = (conv.scale[co], conv.bias[co]);
-        let dst = &mut out[co * s..(co + 1) * s];
-        match mode {
-            Accumulate::Overwrite => {
-                dst[..PAD].fill(0.0);
-                dst[PAD + len..].fill(0.0);
-                for (d, a) in dst[PAD..PAD + len].iter_mut().zip(acc.iter()) {
-                    *d = *a * scale + bias;
-                }
-            }
-            Accumulate::Add => {
-                for (d, a) in dst[PAD..PAD + len].iter_mut().zip(acc.iter()) {
-                    *d += *a * scale + bias;
+/// Output positions one tile covers (two SSE registers, one AVX register, per channel).
+const TILE: usize = 8;
+/// Output channels one tile covers.
+const TILE_CHANNELS: usize = 4;
+/// Taps of the widest convolution (an up level's concatenated input, kernel `KERNEL`).
+const MAX_TAPS: usize = 2 * MAX_WIDTH * KERNEL;
+
+/// One channel group's weights as f32, `[ci][tap][c]`.
+type WeightTile = [f32; MAX_TAPS * TILE_CHANNELS];
+
+/// `CO` output channels × `TILE` positions of a stride-1 convolution with `K` taps, accumulated
+/// in registers. `weights` holds the `CO` channels' weights as f32, `[ci][tap][c]`; `input`
+/// starts at the first tap of the tile's first position in channel 0. Each output sums over
+/// input channel, then tap: the order every path keeps.
+#[inline(always)]
+fn conv_tile<const CO: usize, const K: usize>(
+    weights: &[f32],
+    input: &[f32],
+    row: usize,
+    cin: usize,
+) -> [[f32; TILE]; CO] {
+    let mut acc = [[0.0f32; TILE]; CO];
+    for ci in 0..cin {
+        let Some(x_row) = input.get(ci * row..) else { break };
+        for kk in 0..K {
+            let Some(x) = x_row.get(kk..).and_then(|r| r.first_chunk::<TILE>()) else {
+                break;
+            };
+            let Some(w) = weights.get((ci * K + kk) * CO..).and_then(|r| r.first_chunk::<CO>()) else {
+                break;
+            };
+            for (acc_c, w_c) in acc.iter_mut().zip(w) {
+                for (a, v) in acc_c.iter_mut().zip(x) {
+                    *a += w_c * v;
                 }
             }
         }
     }
+    acc
 }
 
-/// Stride-2 convolution, k 3, pad 1: `len` → `out_len` = ⌈len / 2⌉.
-fn conv_down(conv: &Conv, input: &[f32], len: usize, out: &mut [f32], out_len: usize) {
-    let (s, so) = (stride(len), stride(out_len));
-    let mut acc = [0.0f32; LENGTHS[0]];
-    let acc = &mut acc[..out_len];
-    for co in 0..conv.cout {
-        acc.fill(0.0);
-        for ci in 0..conv.cin {
-            let row = &input[ci * s..(ci + 1) * s];
-            let taps = &conv.weights[(co * conv.cin + ci) * conv.k..(co * conv.cin + ci + 1) * conv.k];
-            for (kk, w) in taps.iter().enumerate() {
-                let w = f32::from(*w as i8);
-                // Output l reads input 2l + kk − 1, at padded index PAD − 1 + kk + 2l.
-                let x = row[PAD - 1 + kk..].iter().step_by(2);
-                for (a, v) in acc.iter_mut().zip(x) {
-                    *a += w * v;
-                }
-            }
-        }
-        write_row(&mut out[co * so..(co + 1) * so], acc, conv.scale[co], conv.bias[co]);
+/// "Same" convolution (k 1 or 5, stride 1) over whole rows; writes only data positions, and
+/// zero rows first when overwriting, so pads stay zero. `wbuf` holds one channel group's
+/// weights as f32 (converted once per group, not once per tile).
+fn conv_same(conv: &Conv, input: &[f32], lay: Layout, out: &mut [f32], mode: Accumulate, wbuf: &mut WeightTile) {
+    match conv.k {
+        1 => conv_same_k::<1>(conv, input, lay, out, mode, wbuf),
+        _ => conv_same_k::<KERNEL>(conv, input, lay, out, mode, wbuf),
     }
 }
 
-/// Transposed convolution, k 4, stride 2, pad 1: `len` → 2·len, cropped to `out_len`.
-fn conv_up(conv: &Conv, input: &[f32], len: usize, out: &mut [f32], out_len: usize) {
-    let (s, so) = (stride(len), stride(out_len));
-    let mut acc = [0.0f32; LENGTHS[0]];
-    let acc = &mut acc[..out_len];
-    for co in 0..conv.cout {
-        acc.fill(0.0);
-        for ci in 0..conv.cin {
-            let row = &input[ci * s + PAD..ci * s + PAD + len];
-            let taps = &conv.weights[(co * conv.cin + ci) * conv.k..(co * conv.cin + ci + 1) * conv.k];
-            for (kk, w) in taps.iter().enumerate() {
-                let w = f32::from(*w as i8);
-                // Input i lands on output 2i + kk − 1.
-                for (i, v) in row.iter().enumerate() {
-                    let o = 2 * i + kk;
-                    if o >= 1 && o - 1 < out_len {
-                        acc[o - 1] += w * v;
+fn conv_same_k<const K: usize>(
+    conv: &Conv,
+    input: &[f32],
+    lay: Layout,
+    out: &mut [f32],
+    mode: Accumulate,
+    wbuf: &mut WeightTile,
+) {
+    let mut co0 = 0;
+    while co0 < conv.cout {
+        if co0 + TILE_CHANNELS <= conv.cout {
+            conv_rows::<TILE_CHANNELS, K>(conv, input, lay, co0, out, mode, wbuf);
+            co0 += TILE_CHANNELS;
+        } else {
+            conv_rows::<1, K>(conv, input, lay, co0, out, mode, wbuf);
+            co0 += 1;
+        }
+    }
+}
+
+#[inline(always)]
+fn conv_rows<const CO: usize, const K: usize>(
+    conv: &Conv,
+    input: &[f32],
+    lay: Layout,
+    co0: usize,
+    out: &mut [f32],
+    mode: Accumulate,
+    wbuf: &mut WeightTile,
+) {
+    let (row, seg) = (lay.row(), lay.seg());
+    let shift = PAD - K / 2;
+    let taps = conv.cin * K;
+    for c in 0..CO {
+        let w = conv.weights.get((co0 + c) * taps..(co0 + c + 1) * taps).unwrap_or(&[]);
+        for (t, w) in w.iter().enumerate() {
+            wbuf[t * CO + c] = f32::from(*w as i8);
+        }
+    }
+    if mode == Accumulate::Overwrite {
+        out[co0 * row..(co0 + CO) * row].fill(0.0);
+    }
+    // Output q sits at row index q + PAD and reads input q + shift .. q + shift + K.
+    let outputs = lay.batch * seg - 2 * PAD;
+    let mut q0 = 0;
+    while q0 < outputs {
+        let acc = conv_tile::<CO, K>(&wbuf[..taps * CO], &input[shift + q0..], row, conv.cin);
+        // Keep the tile's data positions: trajectory b's run [b·seg + PAD, b·seg + PAD + len).
+        let (lo, hi) = (q0 + PAD, (q0 + PAD + TILE).min(outputs + PAD));
+        let mut b = lo / seg;
+        while b * seg + PAD < hi {
+            let (from, to) = ((b * seg + PAD).max(lo), (b * seg + PAD + lay.len).min(hi));
+            if from < to {
+                for (c, acc_c) in acc.iter().enumerate() {
+                    let (scale, bias) = (conv.scale[co0 + c], conv.bias[co0 + c]);
+                    let dst = &mut out[(co0 + c) * row + from..(co0 + c) * row + to];
+                    for (d, a) in dst.iter_mut().zip(&acc_c[from - lo..]) {
+                        match mode {
+                            Accumulate::Overwrite => *d = *a * scale + bias,
+                            Accumulate::Add => *d += *a * scale + bias,
+                        }
                     }
                 }
             }
+            b += 1;
         }
-        write_row(&mut out[co * so..(co + 1) * so], acc, conv.scale[co], conv.bias[co]);
+        q0 += TILE;
     }
 }
 
-fn write_row(dst: &mut [f32], acc: &[f32], scale: f32, bias: f32) {
-    let len = acc.len();
-    dst[..PAD].fill(0.0);
-    dst[PAD + len..].fill(0.0);
-    for (d, a) in dst[PAD..PAD + len].iter_mut().zip(acc) {
+/// Stride-2 convolution, k 3, pad 1, per trajectory: `len` → ⌈len / 2⌉.
+fn conv_down(conv: &Conv, input: &[f32], lay: Layout, out: &mut [f32], lay_out: Layout) {
+    let mut acc = [0.0f32; LENGTHS[0]];
+    let acc = &mut acc[..lay_out.len];
+    out[..conv.cout * lay_out.row()].fill(0.0);
+    for co in 0..conv.cout {
+        for b in 0..lay.batch {
+            acc.fill(0.0);
+            for ci in 0..conv.cin {
+                let taps = &conv.weights[(co * conv.cin + ci) * conv.k..(co * conv.cin + ci + 1) * conv.k];
+                for (kk, w) in taps.iter().enumerate() {
+                    let w = f32::from(*w as i8);
+                    // Output l reads input 2l + kk − 1.
+                    let x = input[lay.at(ci, b, 0) + kk - 1..].iter().step_by(2);
+                    for (a, v) in acc.iter_mut().zip(x) {
+                        *a += w * v;
+                    }
+                }
+            }
+            let start = lay_out.at(co, b, 0);
+            write_run(&mut out[start..start + lay_out.len], acc, conv.scale[co], conv.bias[co]);
+        }
+    }
+}
+
+/// Transposed convolution, k 4, stride 2, pad 1, per trajectory: `len` → 2·len, cropped.
+/// Input i lands on output 2i + k − 1, so output 2m takes taps 1 (x_m) and 3 (x_{m−1}) and
+/// output 2m + 1 takes taps 0 (x_{m+1}) and 2 (x_m); the zero pads supply x_{−1} and x_len.
+fn conv_up(conv: &Conv, input: &[f32], lay: Layout, out: &mut [f32], lay_out: Layout) {
+    let len = lay.len;
+    let (mut even, mut odd) = ([0.0f32; LENGTHS[0]], [0.0f32; LENGTHS[0]]);
+    let mut acc = [0.0f32; LENGTHS[0]];
+    out[..conv.cout * lay_out.row()].fill(0.0);
+    for co in 0..conv.cout {
+        for b in 0..lay.batch {
+            even[..len].fill(0.0);
+            odd[..len].fill(0.0);
+            for ci in 0..conv.cin {
+                let at = lay.at(ci, b, 0);
+                let w = &conv.weights[(co * conv.cin + ci) * 4..(co * conv.cin + ci + 1) * 4];
+                let [w0, w1, w2, w3] = [0, 1, 2, 3].map(|k| f32::from(w[k] as i8));
+                let (prev, here, next) = (
+                    &input[at - 1..at - 1 + len],
+                    &input[at..at + len],
+                    &input[at + 1..at + 1 + len],
+                );
+                for (((e, o), (p, h)), n) in even[..len]
+                    .iter_mut()
+                    .zip(&mut odd[..len])
+                    .zip(prev.iter().zip(here))
+                    .zip(next)
+                {
+                    *e += w1 * h;
+                    *e += w3 * p;
+                    *o += w0 * n;
+                    *o += w2 * h;
+                }
+            }
+            for (m, (e, o)) in even[..len].iter().zip(&odd[..len]).enumerate() {
+                if 2 * m < lay_out.len {
+                    acc[2 * m] = *e;
+                }
+                if 2 * m + 1 < lay_out.len {
+                    acc[2 * m + 1] = *o;
+                }
+            }
+            let start = lay_out.at(co, b, 0);
+            write_run(
+                &mut out[start..start + lay_out.len],
+                &acc[..lay_out.len],
+                conv.scale[co],
+                conv.bias[co],
+            );
+        }
+    }
+}
+
+fn write_run(dst: &mut [f32], acc: &[f32], scale: f32, bias: f32) {
+    for (d, a) in dst.iter_mut().zip(acc) {
         *d = *a * scale + bias;
     }
 }
 
-/// GroupNorm (biased variance, ε 1e-5, two passes) then Mish, in place on the data columns.
-fn norm_mish(x: &mut [f32], channels: usize, len: usize, gamma: &[f32], beta: &[f32]) {
-    let s = stride(len);
+/// GroupNorm (per trajectory; biased variance, ε 1e-5, two passes) then Mish, in place on the
+/// data positions. The `expf`s go first, run by run, so the rest of Mish vectorizes.
+fn norm_mish(x: &mut [f32], channels: usize, lay: Layout, gamma: &[f32], beta: &[f32]) {
+    let len = lay.len;
     let per_group = channels / GROUPS;
     let count = (per_group * len) as f32;
-    for g in 0..GROUPS {
-        let rows = g * per_group..(g + 1) * per_group;
-        let mut sum = 0.0f32;
-        for c in rows.clone() {
-            sum += x[c * s + PAD..c * s + PAD + len].iter().fold(0.0f32, |a, v| a + v);
-        }
-        let mean = sum / count;
-        let mut var = 0.0f32;
-        for c in rows.clone() {
-            var += x[c * s + PAD..c * s + PAD + len].iter().fold(0.0f32, |a, v| a + (v - mean) * (v - mean));
-        }
-        let inv = 1.0 / libm::sqrtf(var / count + 1e-5);
-        for c in rows {
-            let (ga, be) = (gamma[c] * inv, beta[c]);
-            for v in &mut x[c * s + PAD..c * s + PAD + len] {
-                *v = mish((*v - mean) * ga + be);
+    let mut u = [0.0f32; LENGTHS[0]];
+    for b in 0..lay.batch {
+        for g in 0..GROUPS {
+            let rows = g * per_group..(g + 1) * per_group;
+            let mut sum = 0.0f32;
+            for c in rows.clone() {
+                sum += x[lay.at(c, b, 0)..lay.at(c, b, len)].iter().fold(0.0f32, |a, v| a + v);
+            }
+            let mean = sum / count;
+            let mut var = 0.0f32;
+            for c in rows.clone() {
+                var += x[lay.at(c, b, 0)..lay.at(c, b, len)]
+                    .iter()
+                    .fold(0.0f32, |a, v| a + (v - mean) * (v - mean));
+            }
+            let inv = 1.0 / libm::sqrtf(var / count + 1e-5);
+            for c in rows {
+                let (ga, be) = (gamma[c] * inv, beta[c]);
+                let run = &mut x[lay.at(c, b, 0)..lay.at(c, b, len)];
+                for (v, e) in run.iter_mut().zip(&mut u) {
+                    *v = (*v - mean) * ga + be;
+                    *e = libm::expf(v.min(20.0));
+                }
+                for (v, e) in run.iter_mut().zip(&u) {
+                    *v = mish_from_exp(*v, *e);
+                }
             }
         }
     }
 }
 
-fn conv_block(block: &ConvBlock, input: &[f32], len: usize, out: &mut [f32]) {
-    conv_same(&block.conv, input, len, out, Accumulate::Overwrite);
-    norm_mish(out, block.conv.cout, len, block.gamma, block.beta);
+fn conv_block(block: &ConvBlock, input: &[f32], lay: Layout, out: &mut [f32], wbuf: &mut WeightTile) {
+    conv_same(&block.conv, input, lay, out, Accumulate::Overwrite, wbuf);
+    norm_mish(out, block.conv.cout, lay, block.gamma, block.beta);
 }
 
 /// `out = block1(block0(x) + time) + residual(x)`, `h` is scratch.
-fn res_block(block: &ResBlock, x: &[f32], len: usize, temb: &[f32; TIME_DIM], h: &mut [f32], out: &mut [f32]) {
-    let s = stride(len);
+fn res_block(
+    block: &ResBlock,
+    x: &[f32],
+    lay: Layout,
+    temb: &[f32; TIME_DIM],
+    h: &mut [f32],
+    out: &mut [f32],
+    wbuf: &mut WeightTile,
+) {
     let cout = block.block0.conv.cout;
-    conv_block(&block.block0, x, len, h);
+    conv_block(&block.block0, x, lay, h, wbuf);
     let mut shift = [0.0f32; MAX_WIDTH];
     linear(&block.time, temb, &mut shift[..cout]);
     for (c, add) in shift[..cout].iter().enumerate() {
-        for v in &mut h[c * s + PAD..c * s + PAD + len] {
-            *v += add;
+        for b in 0..lay.batch {
+            for v in &mut h[lay.at(c, b, 0)..lay.at(c, b, lay.len)] {
+                *v += add;
+            }
         }
     }
-    conv_block(&block.block1, h, len, out);
+    conv_block(&block.block1, h, lay, out, wbuf);
     match &block.residual {
-        Some(res) => conv_same(res, x, len, out, Accumulate::Add),
+        Some(res) => conv_same(res, x, lay, out, Accumulate::Add, wbuf),
+        // Pads are zero in both, so whole rows add.
         None => {
-            for c in 0..cout {
-                for (o, v) in out[c * s + PAD..c * s + PAD + len].iter_mut().zip(&x[c * s + PAD..c * s + PAD + len]) {
-                    *o += v;
-                }
+            for (o, v) in out[..cout * lay.row()].iter_mut().zip(&x[..cout * lay.row()]) {
+                *o += v;
             }
         }
     }

@@ -1,0 +1,317 @@
+//! `edmp-host sample`: the quality of the unguided prior. For suite start/goal pairs it samples
+//! 12 trajectories per problem with each sampler and prints, per sampler, the roughness metrics
+//! of the paper's Table IV (L2 norm between adjacent waypoints, radians: AR average, MRESG max
+//! excluding the first and last segment, RF2W first segment, RL2W last), the share of
+//! trajectories leaving the hard joint limits or colliding with the robot itself (exact
+//! checker, empty scene), and the sampling time. `--data` adds the same row for the training
+//! trajectories; `--plot` draws some samples, joint by joint, to a PNG.
+
+use crate::json::{Goal, parse_problem};
+use crate::render::Canvas;
+use edmp_core::checker::{CheckConfig, check_trajectory};
+use edmp_core::prior::{HORIZON, Path, Sampler, Scratch, sample};
+use edmp_core::rng::Rng;
+use edmp_core::robot::{JOINTS, PANDA};
+use edmp_core::scene::Scene;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use std::path::PathBuf;
+
+/// Trajectories per problem: one ensemble's worth.
+const BATCH: usize = 12;
+
+/// Arguments of `edmp-host sample`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// Folder with one sub-folder of `edmp-scene/1` files per family (start and joint goal used).
+    #[arg(long, default_value = "benchmarks/problems")]
+    problems: PathBuf,
+    /// Problems per family (the first N of each).
+    #[arg(long, default_value_t = 25)]
+    per_family: usize,
+    /// Samplers: `ancestral` (EDMP's 255 steps) and `ddim:K`.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "ancestral,ddim:50,ddim:25,ddim:10,ddim:5"
+    )]
+    samplers: Vec<String>,
+    /// Training data (`gen-data` .npy) to measure the same metrics on (its last 1,200 trajectories,
+    /// which the trainer holds out).
+    #[arg(long)]
+    data: Option<PathBuf>,
+    /// Draw the first problem's samples (first and last sampler given) to this PNG.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Random seed (problem i uses seed + i).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+fn parse_sampler(s: &str) -> Result<Sampler, String> {
+    let sampler = match s.split_once(':') {
+        None if s == "ancestral" => Sampler::Ancestral,
+        Some(("ddim", k)) => Sampler::Ddim {
+            steps: k
+                .parse()
+                .map_err(|_| format!("--samplers: `{s}`: K must be an integer"))?,
+        },
+        _ => return Err(format!("--samplers: `{s}` is neither `ancestral` nor `ddim:K`")),
+    };
+    sampler
+        .validate()
+        .map_err(|_| format!("--samplers: `{s}`: K must be 1..={}", edmp_core::prior::STEPS))?;
+    Ok(sampler)
+}
+
+fn name(sampler: Sampler) -> String {
+    match sampler {
+        Sampler::Ancestral => format!("ancestral, K = {}", edmp_core::prior::STEPS),
+        Sampler::Ddim { steps } => format!("DDIM, K = {steps}"),
+    }
+}
+
+/// Per-trajectory measurements.
+#[derive(Clone, Copy, Default)]
+struct Quality {
+    ar: f64,
+    mresg: f64,
+    rf2w: f64,
+    rl2w: f64,
+    outside_limits: bool,
+    self_colliding: bool,
+}
+
+fn step_norm(a: &[f32; JOINTS], b: &[f32; JOINTS]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| f64::from(x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+fn quality(x: &Path, empty: &Scene<1>) -> Quality {
+    let steps: Vec<f64> = x.windows(2).map(|w| step_norm(&w[0], &w[1])).collect();
+    let outside_limits = x.iter().flatten().enumerate().any(|(i, v)| {
+        let j = i % JOINTS;
+        *v < PANDA.hard_lower[j] || *v > PANDA.hard_upper[j]
+    });
+    let config = CheckConfig {
+        self_collision: true,
+        ..CheckConfig::default()
+    };
+    let self_colliding = check_trajectory(empty, x, &config, true).map_or(true, |r| !r.is_free());
+    Quality {
+        ar: steps.iter().sum::<f64>() / steps.len() as f64,
+        mresg: steps[1..steps.len() - 1].iter().copied().fold(0.0, f64::max),
+        rf2w: steps[0],
+        rl2w: steps[steps.len() - 1],
+        outside_limits,
+        self_colliding,
+    }
+}
+
+fn row(label: &str, q: &[Quality], ms: Option<(f64, f64)>) -> String {
+    let n = q.len() as f64;
+    let mean = |f: fn(&Quality) -> f64| q.iter().map(f).sum::<f64>() / n;
+    let share = |f: fn(&Quality) -> bool| 100.0 * q.iter().filter(|x| f(x)).count() as f64 / n;
+    let time = ms.map_or_else(|| "–".to_owned(), |(median, p95)| format!("{median:.1} / {p95:.1}"));
+    format!(
+        "| {label} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.1} | {:.1} | {time} |",
+        q.len(),
+        mean(|x| x.ar),
+        mean(|x| x.mresg),
+        mean(|x| x.rf2w),
+        mean(|x| x.rl2w),
+        share(|x| x.outside_limits),
+        share(|x| x.self_colliding),
+    )
+}
+
+fn read_npy(path: &std::path::Path) -> Result<Vec<Path>, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let bad = || {
+        format!(
+            "{}: not a float32 (N, {HORIZON}, {JOINTS}) .npy from gen-data",
+            path.display()
+        )
+    };
+    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+        return Err(bad());
+    }
+    let header_len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
+    let header = core::str::from_utf8(bytes.get(10..10 + header_len).ok_or_else(bad)?).map_err(|_| bad())?;
+    if !header.contains("'<f4'") || !header.contains(&format!(", {HORIZON}, {JOINTS})")) {
+        return Err(bad());
+    }
+    let data = &bytes[10 + header_len..];
+    let per = HORIZON * JOINTS * 4;
+    Ok(data
+        .chunks_exact(per)
+        .map(|t| {
+            core::array::from_fn(|w| {
+                core::array::from_fn(|j| {
+                    let i = (w * JOINTS + j) * 4;
+                    f32::from_le_bytes([t[i], t[i + 1], t[i + 2], t[i + 3]])
+                })
+            })
+        })
+        .collect())
+}
+
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    sorted[((sorted.len() - 1) as f64 * q).round() as usize]
+}
+
+/// Runs the measurement and prints the table.
+pub(crate) fn run(args: &Args) -> Result<(), String> {
+    let samplers = args
+        .samplers
+        .iter()
+        .map(|s| parse_sampler(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    if samplers.is_empty() {
+        return Err("--samplers: give at least one".into());
+    }
+    let mut problems = Vec::new();
+    let mut families: Vec<PathBuf> = std::fs::read_dir(&args.problems)
+        .map_err(|e| format!("{}: {e}", args.problems.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_dir())
+        .collect();
+    families.sort();
+    for family in &families {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(family)
+            .map_err(|e| format!("{}: {e}", family.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "json"))
+            .collect();
+        files.sort();
+        for path in files.into_iter().take(args.per_family) {
+            let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let p = parse_problem(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+            let Goal::Joints(goal) = p.goal else {
+                return Err(format!("{}: suite problems have joint goals", path.display()));
+            };
+            problems.push((p.start, goal));
+        }
+    }
+    if problems.is_empty() {
+        return Err(format!("{}: no problems found", args.problems.display()));
+    }
+    let empty = Scene::<1>::new();
+    println!(
+        "Unguided prior, {} problems x {BATCH} trajectories ({} parameters, {} MAC per forward); \
+         roughness in radians (joint-space L2 between adjacent waypoints), time per problem on one core.\n",
+        problems.len(),
+        edmp_core::prior::PARAMETERS,
+        edmp_core::prior::MACS
+    );
+    println!(
+        "| source | trajectories | AR | MRESG | RF2W | RL2W | outside hard limits % | self-colliding % | ms median / p95 |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    if let Some(data) = &args.data {
+        let all = read_npy(data)?;
+        let held = &all[all.len().saturating_sub(1200)..];
+        let q: Vec<Quality> = held.par_iter().map(|x| quality(x, &empty)).collect();
+        println!("{}", row("training data (held out)", &q, None));
+    }
+    let mut plotted: Vec<(Sampler, [Path; BATCH])> = Vec::new();
+    for &sampler in &samplers {
+        let bar = ProgressBar::new(problems.len() as u64).with_style(
+            ProgressStyle::with_template("{msg:>18} {bar:40} {pos}/{len} [{elapsed} < {eta}]")
+                .map_err(|e| e.to_string())?,
+        );
+        bar.set_message(name(sampler));
+        let results: Vec<Result<(f64, [Path; BATCH]), String>> = problems
+            .par_iter()
+            .enumerate()
+            .map(|(i, (start, goal))| {
+                let mut scratch = Box::new(Scratch::<BATCH>::new());
+                let mut out = Box::new([[[0.0f32; JOINTS]; HORIZON]; BATCH]);
+                let began = std::time::Instant::now();
+                sample(
+                    sampler,
+                    start,
+                    goal,
+                    &mut Rng::new(args.seed + i as u64),
+                    &mut scratch,
+                    &mut out,
+                )
+                .map_err(|e| format!("problem {i}: {e}"))?;
+                let ms = began.elapsed().as_secs_f64() * 1e3;
+                bar.inc(1);
+                Ok((ms, *out))
+            })
+            .collect();
+        bar.finish_and_clear();
+        let mut times = Vec::new();
+        let mut paths = Vec::new();
+        for r in results {
+            let (ms, out) = r?;
+            times.push(ms);
+            paths.push(out);
+        }
+        times.sort_by(f64::total_cmp);
+        let q: Vec<Quality> = paths.par_iter().flatten().map(|x| quality(x, &empty)).collect();
+        println!(
+            "{}",
+            row(
+                &name(sampler),
+                &q,
+                Some((percentile(&times, 0.5), percentile(&times, 0.95)))
+            )
+        );
+        plotted.push((sampler, paths[0]));
+    }
+    if let Some(path) = &args.plot {
+        let first = plotted.first().map(|p| p.1);
+        let last = plotted.last().map(|p| p.1);
+        if let (Some(a), Some(b)) = (first, last) {
+            plot(path, &a, &b)?;
+            println!(
+                "\nwrote {} (joints top to bottom; blue: {}, orange: {}; grey: hard limits)",
+                path.display(),
+                name(plotted[0].0),
+                name(plotted[plotted.len() - 1].0)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Seven panels, one per joint: waypoint index across, the joint's hard range up.
+fn plot(path: &std::path::Path, a: &[Path; BATCH], b: &[Path; BATCH]) -> Result<(), String> {
+    const W: usize = 900;
+    const PANEL_H: usize = 110;
+    const GAP: usize = 12;
+    let mut canvas = Canvas::new(W, JOINTS * (PANEL_H + GAP) + GAP);
+    let (left, right) = (20.0, W as f32 - 20.0);
+    for j in 0..JOINTS {
+        let top = (GAP + j * (PANEL_H + GAP)) as f32;
+        let (lo, hi) = (PANDA.hard_lower[j], PANDA.hard_upper[j]);
+        let to_px = |w: usize, v: f32| {
+            [
+                left + (right - left) * w as f32 / (HORIZON - 1) as f32,
+                top + PANEL_H as f32 * (hi - v) / (hi - lo),
+            ]
+        };
+        canvas.line([left, top], [right, top], 1.0, [0.6, 0.6, 0.6], 1.0);
+        canvas.line(
+            [left, top + PANEL_H as f32],
+            [right, top + PANEL_H as f32],
+            1.0,
+            [0.6, 0.6, 0.6],
+            1.0,
+        );
+        for (set, color) in [(a, [0.12, 0.47, 0.71]), (b, [1.0, 0.5, 0.05])] {
+            for x in set.iter().take(4) {
+                for w in 0..HORIZON - 1 {
+                    canvas.line(to_px(w, x[w][j]), to_px(w + 1, x[w + 1][j]), 1.6, color, 0.8);
+                }
+            }
+        }
+    }
+    canvas.png(path)
+}
