@@ -6,8 +6,8 @@
 //! step (`scale = max|w| / 127`, `q = round_half_even(w / scale)`), so the integers here and the
 //! fake-quantized PyTorch model that writes the parity fixture agree exactly.
 
-use std::collections::BTreeMap;
 use core::fmt::Write as _;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;

@@ -42,11 +42,11 @@ fn bench(c: &mut Criterion) {
     group.bench_function("time embedding", |b| b.iter(|| TimeEmbedding::new(black_box(128))));
     group.sample_size(10);
     for k in [5u16, 10, 25, 50] {
-        group.bench_function(format!("sample 12 trajectories/ddim K={k}"), |b| {
+        group.bench_function(format!("sample 12 trajectories/strided K={k}"), |b| {
             let mut out = [[[0.0f32; 7]; HORIZON]; 12];
             b.iter(|| {
                 sample(
-                    Sampler::Ddim { steps: k },
+                    Sampler::Strided { steps: k },
                     &START,
                     &GOAL,
                     &mut Rng::new(2),

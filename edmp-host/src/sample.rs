@@ -29,11 +29,11 @@ pub(crate) struct Args {
     /// Problems per family (the first N of each).
     #[arg(long, default_value_t = 25)]
     per_family: usize,
-    /// Samplers: `ancestral` (EDMP's 255 steps) and `ddim:K`.
+    /// Samplers: `ancestral` (EDMP's 255 steps), `strided:K` (its rule on K steps), `ddim:K`.
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "ancestral,ddim:50,ddim:25,ddim:10,ddim:5"
+        default_value = "ancestral,strided:50,strided:25,strided:10,strided:5,ddim:25,ddim:10"
     )]
     samplers: Vec<String>,
     /// Training data (`gen-data` .npy) to measure the same metrics on (its last 1,200 trajectories,
@@ -51,12 +51,21 @@ pub(crate) struct Args {
 fn parse_sampler(s: &str) -> Result<Sampler, String> {
     let sampler = match s.split_once(':') {
         None if s == "ancestral" => Sampler::Ancestral,
-        Some(("ddim", k)) => Sampler::Ddim {
-            steps: k
+        Some((kind @ ("ddim" | "strided"), k)) => {
+            let steps = k
                 .parse()
-                .map_err(|_| format!("--samplers: `{s}`: K must be an integer"))?,
-        },
-        _ => return Err(format!("--samplers: `{s}` is neither `ancestral` nor `ddim:K`")),
+                .map_err(|_| format!("--samplers: `{s}`: K must be an integer"))?;
+            if kind == "ddim" {
+                Sampler::Ddim { steps }
+            } else {
+                Sampler::Strided { steps }
+            }
+        }
+        _ => {
+            return Err(format!(
+                "--samplers: `{s}` is none of `ancestral`, `strided:K`, `ddim:K`"
+            ));
+        }
     };
     sampler
         .validate()
@@ -67,6 +76,7 @@ fn parse_sampler(s: &str) -> Result<Sampler, String> {
 fn name(sampler: Sampler) -> String {
     match sampler {
         Sampler::Ancestral => format!("ancestral, K = {}", edmp_core::prior::STEPS),
+        Sampler::Strided { steps } => format!("strided, K = {steps}"),
         Sampler::Ddim { steps } => format!("DDIM, K = {steps}"),
     }
 }

@@ -22,9 +22,13 @@ fn a_fixed_sampling_run_hashes_to_its_golden_value() {
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut out: [Path; 4] = [[[0.0; 7]; HORIZON]; 4];
     let mut hashes = Vec::new();
-    for sampler in [Sampler::Ddim { steps: 10 }, Sampler::Ancestral] {
+    for sampler in [
+        Sampler::Ddim { steps: 10 },
+        Sampler::Strided { steps: 10 },
+        Sampler::Ancestral,
+    ] {
         sample(sampler, &start, &goal, &mut Rng::new(20261122), &mut scratch, &mut out).unwrap();
         hashes.push(hash(&out));
     }
-    println!("sampling hashes: {:#018x} {:#018x}", hashes[0], hashes[1]);
+    println!("sampling hashes: {hashes:#018x?}");
 }

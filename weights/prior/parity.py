@@ -18,7 +18,7 @@ import torch
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from model import T, TemporalUNet, fake_quantized, schedule  # noqa: E402
+from model import T, TemporalUNet, fake_quantized, is_quantized, schedule  # noqa: E402
 
 
 def load(directory):
@@ -89,6 +89,40 @@ def main():
         f.write("\n")
     print(f"{len(cases)} cases -> {os.path.relpath(args.out)}; int8 vs float: max |diff| {worst_q:.3e}, "
           f"max relative to the case's max |eps| {max(rel):.3e} (T = {T})")
+    compare_quantization(model, data)
+
+
+def per_tensor(model):
+    """The alternative measured against: one symmetric scale per tensor."""
+    import copy
+
+    fq = copy.deepcopy(model)
+    with torch.no_grad():
+        for name, p in fq.named_parameters():
+            if is_quantized(name, p):
+                scale = p.abs().max() / 127.0
+                p.copy_(torch.clamp(torch.round(p / scale), -127, 127) * scale)
+    return fq
+
+
+def compare_quantization(model, data, n=2000):
+    """Held-out loss (interior epsilon MSE, t uniform) of the float model and two int8 schemes."""
+    _, _, alpha_bars = schedule()
+    gen = torch.Generator().manual_seed(7)
+    x0 = torch.from_numpy(np.array(data[len(data) - n :]).transpose(0, 2, 1).copy()).float()
+    t = torch.randint(1, T + 1, (n,), generator=gen)
+    eps = torch.randn(x0.shape, generator=gen)
+    ab = alpha_bars[t - 1].float()[:, None, None]
+    xt = ab.sqrt() * x0 + (1 - ab).sqrt() * eps
+    xt[:, :, 0], xt[:, :, -1] = x0[:, :, 0], x0[:, :, -1]
+    with torch.no_grad():
+        ref = model(xt, t)
+        for label, net in (("float32", model), ("int8 per output channel (used)", fake_quantized(model)),
+                           ("int8 per tensor", per_tensor(model))):
+            out = ref if net is model else net(xt, t)
+            loss = ((out - eps)[:, :, 1:-1] ** 2).mean().item()
+            rms = ((out - ref) ** 2).mean().sqrt().item()
+            print(f"  {label:32s} held-out loss {loss:.5f}   rms difference from float {rms:.5f}")
 
 
 if __name__ == "__main__":

@@ -1,11 +1,12 @@
 //! The diffusion prior over trajectories: the trained int8 UNet ([`predict_noise`]) and the
 //! reverse-diffusion samplers that turn noise into a trajectory between a start and a goal.
 //!
-//! Two samplers share one step interface, so the guided planner can apply its costs between
+//! Three samplers share one step interface, so the guided planner can apply its costs between
 //! steps: EDMP's original ancestral sampler (all `STEPS` = 255 steps, noise std β_t, exactly
-//! as shared/notes/edmp-reference.md §1), and DDIM (η = 0) on `K` evenly strided steps, which
-//! trades steps for speed. Both write the start and the goal into the first and last waypoint
-//! after every step.
+//! as shared/notes/edmp-reference.md §1); the same rule on `K` evenly strided steps (the
+//! strided step's β' = 1 − ᾱ_t/ᾱ_prev), which trades steps for speed; and DDIM (η = 0) on `K`
+//! strided steps, for comparison. All write the start and the goal into the first and last
+//! waypoint after every step.
 
 mod net;
 
@@ -52,7 +53,13 @@ pub enum Sampler {
     /// EDMP's ancestral sampler: every step t = 255 … 1,
     /// x ← (x − β_t/√(1−ᾱ_t)·ε̂)/√α_t + β_t·z (z = 0 at t = 1).
     Ancestral,
-    /// Deterministic DDIM on `steps` strided steps t_j = T − ⌊j·T/K⌋, j = 0 … K − 1.
+    /// EDMP's rule on `steps` strided steps t_j = T − ⌊j·T/K⌋, j = 0 … K − 1, with the
+    /// strided β' = 1 − ᾱ_t/ᾱ_prev in place of β_t (K = T is the ancestral walk up to rounding).
+    Strided {
+        /// K, 1 ..= `STEPS`.
+        steps: u16,
+    },
+    /// Deterministic DDIM on the same strided steps.
     Ddim {
         /// K, 1 ..= `STEPS`.
         steps: u16,
@@ -73,8 +80,8 @@ impl Sampler {
     pub fn validate(&self) -> Result<(), Error> {
         match *self {
             Self::Ancestral => Ok(()),
-            Self::Ddim { steps } if steps >= 1 && usize::from(steps) <= STEPS => Ok(()),
-            Self::Ddim { .. } => Err(Error::BadParameter),
+            Self::Strided { steps } | Self::Ddim { steps } if steps >= 1 && usize::from(steps) <= STEPS => Ok(()),
+            Self::Strided { .. } | Self::Ddim { .. } => Err(Error::BadParameter),
         }
     }
 
@@ -82,7 +89,7 @@ impl Sampler {
     pub fn evaluations(&self) -> usize {
         match *self {
             Self::Ancestral => STEPS,
-            Self::Ddim { steps } => usize::from(steps),
+            Self::Strided { steps } | Self::Ddim { steps } => usize::from(steps),
         }
     }
 
@@ -121,6 +128,26 @@ impl Sampler {
                     for (xv, ev) in xw.iter_mut().zip(ew) {
                         let z = if step.t > 1 { rng.normal_f32() } else { 0.0 };
                         *xv = a * (*xv - c * ev) + sigma * z;
+                    }
+                }
+            }
+            Self::Strided { .. } => {
+                let abar = |t: u16| match t {
+                    0 => 1.0,
+                    t => {
+                        let s = generated::SQRT_ALPHA_BAR[usize::from(t) - 1];
+                        s * s
+                    }
+                };
+                let beta = 1.0 - abar(step.t) / abar(step.prev);
+                let (a, c) = (
+                    1.0 / libm::sqrtf(1.0 - beta),
+                    beta / generated::SQRT_ONE_MINUS_ALPHA_BAR[i],
+                );
+                for (xw, ew) in x.iter_mut().zip(eps) {
+                    for (xv, ev) in xw.iter_mut().zip(ew) {
+                        let z = if step.prev > 0 { rng.normal_f32() } else { 0.0 };
+                        *xv = a * (*xv - c * ev) + beta * z;
                     }
                 }
             }
@@ -209,6 +236,8 @@ mod tests {
         assert_eq!(Sampler::Ancestral.step(254), Step { t: 1, prev: 0 });
         assert_eq!(Sampler::Ddim { steps: 0 }.validate(), Err(Error::BadParameter));
         assert_eq!(Sampler::Ddim { steps: 256 }.validate(), Err(Error::BadParameter));
+        assert_eq!(Sampler::Strided { steps: 0 }.validate(), Err(Error::BadParameter));
+        assert_eq!(Sampler::Strided { steps: 7 }.step(6), Step { t: 37, prev: 0 });
     }
 
     #[test]
