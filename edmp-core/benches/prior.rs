@@ -26,6 +26,8 @@ fn bench(c: &mut Criterion) {
         initial_noise(x, &mut rng, &START, &GOAL);
     }
     let mut one = Box::new(Scratch::<1>::new());
+    let mut two = Box::new(Scratch::<2>::new());
+    let mut four = Box::new(Scratch::<4>::new());
     let mut scratch = Box::new(Scratch::<12>::new());
     let mut eps: [Path; 12] = [[[0.0; 7]; HORIZON]; 12];
     let time = TimeEmbedding::new(128).unwrap();
@@ -35,7 +37,16 @@ fn bench(c: &mut Criterion) {
         b.iter(|| predict_noise(black_box(&[x[0]]), &time, &mut one, &mut [eps[0]]))
     });
     group.throughput(Throughput::Elements(12));
-    group.bench_function("forward/batch of 12", |b| {
+    group.bench_function("forward/batch of 12, 1 at a time", |b| {
+        b.iter(|| predict_noise(black_box(&x), &time, &mut one, &mut eps))
+    });
+    group.bench_function("forward/batch of 12, 2 at a time", |b| {
+        b.iter(|| predict_noise(black_box(&x), &time, &mut two, &mut eps))
+    });
+    group.bench_function("forward/batch of 12, 4 at a time", |b| {
+        b.iter(|| predict_noise(black_box(&x), &time, &mut four, &mut eps))
+    });
+    group.bench_function("forward/batch of 12, 12 at a time", |b| {
         b.iter(|| predict_noise(black_box(&x), &time, &mut scratch, &mut eps))
     });
     group.throughput(Throughput::Elements(1));

@@ -46,7 +46,7 @@ impl Canvas {
     }
 
     /// Fills a convex polygon (pixel coordinates) blending `color` with opacity `alpha`.
-    fn fill(&mut self, poly: &[[f32; 2]], color: [f32; 3], alpha: f32) {
+    pub(crate) fn fill(&mut self, poly: &[[f32; 2]], color: [f32; 3], alpha: f32) {
         if poly.len() < 3 {
             return;
         }

@@ -301,12 +301,23 @@ fn plot(path: &std::path::Path, a: &[Path; BATCH], b: &[Path; BATCH]) -> Result<
     for j in 0..JOINTS {
         let top = (GAP + j * (PANEL_H + GAP)) as f32;
         let (lo, hi) = (PANDA.hard_lower[j], PANDA.hard_upper[j]);
+        // Values outside the hard range are drawn on the panel's edge.
         let to_px = |w: usize, v: f32| {
             [
                 left + (right - left) * w as f32 / (HORIZON - 1) as f32,
-                top + PANEL_H as f32 * (hi - v) / (hi - lo),
+                top + PANEL_H as f32 * (hi - v.clamp(lo, hi)) / (hi - lo),
             ]
         };
+        canvas.fill(
+            &[
+                [left, top],
+                [right, top],
+                [right, top + PANEL_H as f32],
+                [left, top + PANEL_H as f32],
+            ],
+            [0.5; 3],
+            0.06,
+        );
         canvas.line([left, top], [right, top], 1.0, [0.6, 0.6, 0.6], 1.0);
         canvas.line(
             [left, top + PANEL_H as f32],

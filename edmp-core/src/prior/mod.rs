@@ -195,13 +195,13 @@ fn check_joints(q: &[f32; JOINTS]) -> Result<(), Error> {
 
 /// Unguided sampling of `B` trajectories from `start` to `goal`, all from one `rng` stream
 /// (trajectory 0's noise first, then 1's, at every step). Fixed work: `sampler.evaluations()`
-/// batched network forwards.
-pub fn sample<const B: usize>(
+/// batched network forwards, `C` trajectories at a time.
+pub fn sample<const B: usize, const C: usize>(
     sampler: Sampler,
     start: &[f32; JOINTS],
     goal: &[f32; JOINTS],
     rng: &mut Rng,
-    scratch: &mut Scratch<B>,
+    scratch: &mut Scratch<C>,
     out: &mut [Path; B],
 ) -> Result<(), Error> {
     sampler.validate()?;
@@ -263,14 +263,21 @@ mod tests {
             initial_noise(x, &mut rng, &[0.0; JOINTS], &[0.5; JOINTS]);
         }
         let mut batch = [[[0.0f32; JOINTS]; HORIZON]; 3];
-        predict_noise(&x, &time, &mut std::boxed::Box::new(Scratch::new()), &mut batch).unwrap();
+        predict_noise(&x, &time, &mut std::boxed::Box::new(Scratch::<3>::new()), &mut batch).unwrap();
+        let mut pairs = [[[0.0f32; JOINTS]; HORIZON]; 3];
+        predict_noise(&x, &time, &mut std::boxed::Box::new(Scratch::<2>::new()), &mut pairs).unwrap();
+        assert_eq!(pairs, batch);
         for (xi, bi) in x.iter().zip(&batch) {
             let mut one = [[[0.0f32; JOINTS]; HORIZON]; 1];
-            predict_noise(&[*xi], &time, &mut Scratch::new(), &mut one).unwrap();
+            predict_noise(&[*xi], &time, &mut Scratch::<1>::new(), &mut one).unwrap();
             assert_eq!(&one[0], bi);
         }
+        assert_eq!(
+            predict_noise(&x, &time, &mut Scratch::<0>::new(), &mut batch),
+            Err(Error::BadParameter)
+        );
         x[1][7][3] = f32::NAN;
-        let got = predict_noise(&x, &time, &mut std::boxed::Box::new(Scratch::new()), &mut batch);
+        let got = predict_noise(&x, &time, &mut Scratch::<1>::new(), &mut batch);
         assert_eq!(got, Err(Error::NonFiniteJoint { joint: 3 }));
     }
 
@@ -287,7 +294,7 @@ mod tests {
             &start,
             &goal,
             &mut rng,
-            &mut std::boxed::Box::new(Scratch::new()),
+            &mut std::boxed::Box::new(Scratch::<2>::new()),
             &mut out,
         )
         .unwrap();

@@ -206,50 +206,51 @@ impl TimeEmbedding {
     }
 }
 
-/// Working memory of one forward of `B` trajectories, sized at compile time from the
-/// generated shapes.
+/// Working memory of one forward of up to `C` trajectories at once, sized at compile time from
+/// the generated shapes.
 #[derive(Clone)]
-pub struct Scratch<const B: usize> {
-    bufs: [[[f32; ACTIVATION_FLOATS]; B]; 3],
-    skips: [[f32; SKIP_FLOATS]; B],
+pub struct Scratch<const C: usize> {
+    bufs: [[[f32; ACTIVATION_FLOATS]; C]; 3],
+    skips: [[f32; SKIP_FLOATS]; C],
     weights: WeightTile,
 }
 
-impl<const B: usize> core::fmt::Debug for Scratch<B> {
+impl<const C: usize> core::fmt::Debug for Scratch<C> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "Scratch<{B}>({} bytes)", Self::BYTES)
+        write!(f, "Scratch<{C}>({} bytes)", Self::BYTES)
     }
 }
 
-impl<const B: usize> Default for Scratch<B> {
+impl<const C: usize> Default for Scratch<C> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const B: usize> Scratch<B> {
-    /// Bytes of this scratch: the network's whole working memory for `B` trajectories.
+impl<const C: usize> Scratch<C> {
+    /// Bytes of this scratch: the network's whole working memory for `C` trajectories at once.
     pub const BYTES: usize = core::mem::size_of::<Self>();
 
     /// Zeroed scratch (`const`: it can live in a `static`).
     pub const fn new() -> Self {
         Self {
-            bufs: [[[0.0; ACTIVATION_FLOATS]; B]; 3],
-            skips: [[0.0; SKIP_FLOATS]; B],
+            bufs: [[[0.0; ACTIVATION_FLOATS]; C]; 3],
+            skips: [[0.0; SKIP_FLOATS]; C],
             weights: [0.0; MAX_TAPS * TILE_CHANNELS],
         }
     }
 }
 
 /// Predicts the noise in each of the `B` trajectories of `x` (horizon `LENGTHS[0]`) at the
-/// step `time` was made for. Each trajectory's result is independent of the others in the
-/// batch and of `B`, bit for bit.
+/// step `time` was made for, `C` trajectories at a time (the scratch's capacity: 1 on a
+/// microcontroller, a few on a PC where they share each weight tile). Each trajectory's result
+/// is independent of the others, of `B` and of `C`, bit for bit.
 ///
 /// Refuses non-finite input; an output that overflowed is [`Error::Overflow`].
-pub fn predict_noise<const B: usize>(
+pub fn predict_noise<const B: usize, const C: usize>(
     x: &[Trajectory<{ LENGTHS[0] }>; B],
     time: &TimeEmbedding,
-    scratch: &mut Scratch<B>,
+    scratch: &mut Scratch<C>,
     eps: &mut [Trajectory<{ LENGTHS[0] }>; B],
 ) -> Result<(), Error> {
     for waypoint in x.iter().flatten() {
@@ -257,6 +258,27 @@ pub fn predict_noise<const B: usize>(
             return Err(Error::NonFiniteJoint { joint: joint as u8 });
         }
     }
+    if C == 0 {
+        return Err(Error::BadParameter);
+    }
+    for (x, eps) in x.chunks(C).zip(eps.chunks_mut(C)) {
+        forward(x, time, scratch, eps);
+    }
+    if eps.iter().flatten().flatten().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::Overflow)
+    }
+}
+
+/// One chunk of at most `C` trajectories through the network.
+fn forward<const C: usize>(
+    x: &[Trajectory<{ LENGTHS[0] }>],
+    time: &TimeEmbedding,
+    scratch: &mut Scratch<C>,
+    eps: &mut [Trajectory<{ LENGTHS[0] }>],
+) {
+    let batch = x.len();
     let temb = &time.features;
     let Scratch {
         bufs,
@@ -268,10 +290,7 @@ pub fn predict_noise<const B: usize>(
     let skips = skips.as_flattened_mut();
 
     // Input: channels first, zero pads.
-    let top = Layout {
-        batch: B,
-        len: LENGTHS[0],
-    };
+    let top = Layout { batch, len: LENGTHS[0] };
     x_buf[..JOINTS * top.row()].fill(0.0);
     for (b, trajectory) in x.iter().enumerate() {
         for (l, waypoint) in trajectory.iter().enumerate() {
@@ -284,10 +303,7 @@ pub fn predict_noise<const B: usize>(
     let mut skip_offset = 0;
     let mut channels = JOINTS;
     for (i, level) in NET.down.iter().enumerate() {
-        let lay = Layout {
-            batch: B,
-            len: LENGTHS[i],
-        };
+        let lay = Layout { batch, len: LENGTHS[i] };
         res_block(&level.res0, x_buf, lay, temb, h_buf, y_buf, wbuf);
         core::mem::swap(&mut x_buf, &mut y_buf);
         res_block(&level.res1, x_buf, lay, temb, h_buf, y_buf, wbuf);
@@ -305,7 +321,7 @@ pub fn predict_noise<const B: usize>(
                 lay,
                 y_buf,
                 Layout {
-                    batch: B,
+                    batch,
                     len: LENGTHS[i + 1],
                 },
             );
@@ -313,7 +329,7 @@ pub fn predict_noise<const B: usize>(
         }
     }
     let deepest = Layout {
-        batch: B,
+        batch,
         len: LENGTHS[LEVELS - 1],
     };
     res_block(&NET.mid0, x_buf, deepest, temb, h_buf, y_buf, wbuf);
@@ -323,10 +339,7 @@ pub fn predict_noise<const B: usize>(
 
     for (j, level) in NET.up.iter().enumerate() {
         let i = LEVELS - 1 - j;
-        let lay = Layout {
-            batch: B,
-            len: LENGTHS[i],
-        };
+        let lay = Layout { batch, len: LENGTHS[i] };
         // Concatenate [x, skip_i] on channels: the skip's rows follow x's.
         let n = channels * lay.row();
         skip_offset -= n;
@@ -341,7 +354,7 @@ pub fn predict_noise<const B: usize>(
             lay,
             y_buf,
             Layout {
-                batch: B,
+                batch,
                 len: LENGTHS[i - 1],
             },
         );
@@ -360,11 +373,6 @@ pub fn predict_noise<const B: usize>(
                 *v = h_buf[top.at(j, b, l)];
             }
         }
-    }
-    if eps.iter().flatten().flatten().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(Error::Overflow)
     }
 }
 
