@@ -407,6 +407,8 @@ pub fn generate_prior(dir: &Path, display: &str) -> Result<GeneratedPrior, Strin
         "/// Sequence length of each level (50, 25, 13: stride-2 convs, crops on the way up)."
     );
     let _ = writeln!(s, "pub const LENGTHS: [usize; LEVELS] = {lengths:?};");
+    let _ = writeln!(s, "/// Joints the network was trained on (input and output channels).");
+    let _ = writeln!(s, "pub const JOINTS: usize = {};", cfg.joints);
     let _ = writeln!(s, "/// Convolution kernel of the residual blocks.");
     let _ = writeln!(s, "pub const KERNEL: usize = {};", cfg.kernel);
     let _ = writeln!(s, "/// GroupNorm groups.");

@@ -40,7 +40,8 @@ pub(crate) struct Args {
     /// which the trainer holds out).
     #[arg(long)]
     data: Option<PathBuf>,
-    /// Draw the first problem's samples (first and last sampler given) to this PNG.
+    /// Draw the samples of the problem with the longest start-to-goal distance (first and last
+    /// sampler given) to this PNG.
     #[arg(long)]
     plot: Option<PathBuf>,
     /// Random seed (problem i uses seed + i).
@@ -227,6 +228,13 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
         let q: Vec<Quality> = held.par_iter().map(|x| quality(x, &empty)).collect();
         println!("{}", row("training data (held out)", &q, None));
     }
+    // The plot shows the problem with the longest way from start to goal.
+    let shown = (0..problems.len())
+        .max_by(|a, b| {
+            let d = |i: usize| step_norm(&problems[i].0, &problems[i].1);
+            d(*a).total_cmp(&d(*b))
+        })
+        .unwrap_or(0);
     let mut plotted: Vec<(Sampler, [Path; BATCH])> = Vec::new();
     for &sampler in &samplers {
         let bar = ProgressBar::new(problems.len() as u64).with_style(
@@ -238,7 +246,7 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
             .par_iter()
             .enumerate()
             .map(|(i, (start, goal))| {
-                let mut scratch = Box::new(Scratch::<BATCH>::new());
+                let mut scratch = Box::new(Scratch::<4>::new());
                 let mut out = Box::new([[[0.0f32; JOINTS]; HORIZON]; BATCH]);
                 let began = std::time::Instant::now();
                 sample(
@@ -273,7 +281,7 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
                 Some((percentile(&times, 0.5), percentile(&times, 0.95)))
             )
         );
-        plotted.push((sampler, paths[0]));
+        plotted.push((sampler, paths[shown]));
     }
     if let Some(path) = &args.plot {
         let first = plotted.first().map(|p| p.1);

@@ -5,6 +5,11 @@
 use edmp_core::prior::{HORIZON, Path, Sampler, Scratch, sample};
 use edmp_core::rng::Rng;
 
+/// Hashes of the run below with the committed weights (DDIM K = 10, strided K = 10, ancestral).
+const GOLDEN_DDIM_10: u64 = 0xac86_999d_30f3_71cb;
+const GOLDEN_STRIDED_10: u64 = 0x43f3_0154_835c_bdfd;
+const GOLDEN_ANCESTRAL: u64 = 0xe9ee_ee9c_2add_6837;
+
 /// FNV-1a over the f32 bit patterns, waypoint-major, trajectory by trajectory.
 fn hash(paths: &[Path]) -> u64 {
     paths.iter().flatten().flatten().fold(0xcbf2_9ce4_8422_2325u64, |h, v| {
@@ -31,4 +36,10 @@ fn a_fixed_sampling_run_hashes_to_its_golden_value() {
         hashes.push(hash(&out));
     }
     println!("sampling hashes: {hashes:#018x?}");
+    assert_eq!(
+        hashes,
+        [GOLDEN_DDIM_10, GOLDEN_STRIDED_10, GOLDEN_ANCESTRAL],
+        "the sampling bits changed: if weights/prior was retrained on purpose, update the golden values; \
+         otherwise the arithmetic changed (an FMA, a reordered sum, a different libm)"
+    );
 }

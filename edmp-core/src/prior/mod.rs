@@ -31,6 +31,9 @@ use crate::robot::JOINTS;
 /// Waypoints of a trajectory the prior makes.
 pub const HORIZON: usize = LENGTHS[0];
 
+// The network must have been trained on this robot's joints.
+const _: () = assert!(generated::JOINTS == JOINTS, "weights/prior was trained for another joint count");
+
 /// A trajectory of the prior's horizon.
 pub type Path = Trajectory<HORIZON>;
 
