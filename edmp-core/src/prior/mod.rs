@@ -32,7 +32,10 @@ use crate::robot::JOINTS;
 pub const HORIZON: usize = LENGTHS[0];
 
 // The network must have been trained on this robot's joints.
-const _: () = assert!(generated::JOINTS == JOINTS, "weights/prior was trained for another joint count");
+const _: () = assert!(
+    generated::JOINTS == JOINTS,
+    "weights/prior was trained for another joint count"
+);
 
 /// A trajectory of the prior's horizon.
 pub type Path = Trajectory<HORIZON>;
