@@ -24,6 +24,7 @@ pub mod cost;
 pub mod error;
 pub mod geometry;
 pub mod gjk;
+pub mod guidance;
 pub mod guides;
 pub mod ik;
 pub mod kinematics;

@@ -1,0 +1,205 @@
+//! One guidance step of EDMP: every row of the batch moves down its guide's cost gradient.
+//!
+//! Rows `g·k … g·k + k − 1` follow guide `g` (k = rows / guides, as the original lays out its
+//! batch). Each gradient is taken at the row clipped to the hard joint limits and applied to the
+//! unclipped row, interior waypoints only (shared/notes/edmp-reference.md §3). Normalized guides
+//! divide by the norm of their own k rows' gradient and skip the step when it is zero: the
+//! original's batch-wide norm couples guides and turns an all-zero gradient into NaN.
+
+use crate::cost::{CostConfig, trajectory_cost};
+use crate::error::Error;
+use crate::geometry::CylinderBox;
+use crate::guides::Guide;
+use crate::kinematics::Joints;
+use crate::robot::PANDA;
+use crate::scene::Scene;
+
+/// Applies every row's guide once at diffusion step `t`. `grads` is working memory, one entry
+/// per row. Fails with [`Error::BadParameter`] if the rows do not split evenly over the guides or
+/// `grads` has another length; non-finite joints and overflowing results are typed errors too,
+/// and then `rows` may be partly updated.
+pub fn guide_step<const H: usize, const N: usize>(
+    scene: &Scene<N>,
+    rows: &mut [[Joints<f32>; H]],
+    grads: &mut [[Joints<f32>; H]],
+    guides: &[Guide],
+    t: u16,
+    cylinder: CylinderBox,
+) -> Result<(), Error> {
+    if guides.is_empty() || !rows.len().is_multiple_of(guides.len()) || grads.len() != rows.len() || H < 3 {
+        return Err(Error::BadParameter);
+    }
+    let per_guide = rows.len() / guides.len();
+    if per_guide == 0 {
+        return Ok(());
+    }
+    for ((guide, rows), grads) in guides
+        .iter()
+        .zip(rows.chunks_mut(per_guide))
+        .zip(grads.chunks_mut(per_guide))
+    {
+        let config = CostConfig {
+            kind: guide.cost,
+            inflation: guide.inflation(t),
+            cylinder,
+        };
+        let mut norm2 = 0.0f32;
+        for (row, grad) in rows.iter().zip(grads.iter_mut()) {
+            let clipped = row.map(|q| core::array::from_fn(|j| q[j].clamp(PANDA.hard_lower[j], PANDA.hard_upper[j])));
+            trajectory_cost(scene, &clipped, &config, Some(grad))?;
+            norm2 += grad[1..H - 1].iter().flatten().map(|g| g * g).sum::<f32>();
+        }
+        let step = guide.step.at(t);
+        let scale = if !guide.normalize {
+            step
+        } else if norm2 > 0.0 && norm2.is_finite() {
+            step / libm::sqrtf(norm2)
+        } else if norm2 == 0.0 {
+            continue;
+        } else {
+            return Err(Error::Overflow);
+        };
+        for (row, grad) in rows.iter_mut().zip(grads.iter()) {
+            for (q, g) in row[1..H - 1].iter_mut().zip(&grad[1..H - 1]) {
+                for (qj, gj) in q.iter_mut().zip(g) {
+                    *qj -= scale * gj;
+                }
+            }
+            if row.iter().flatten().any(|v| !v.is_finite()) {
+                return Err(Error::Overflow);
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cost::CostKind;
+    use crate::guides::EDMP_GUIDES;
+    use crate::scene::Obstacle;
+
+    const H: usize = 12;
+
+    fn line(a: Joints<f32>, b: Joints<f32>) -> [Joints<f32>; H] {
+        core::array::from_fn(|w| {
+            let s = w as f32 / (H - 1) as f32;
+            core::array::from_fn(|j| a[j] + s * (b[j] - a[j]))
+        })
+    }
+
+    /// A box in front of the robot that a sweep of joint 1 passes through.
+    fn scene() -> Scene<4> {
+        let mut s = Scene::new();
+        let wall = Obstacle::cuboid([0.55, 0.0, 0.45], [0.1, 0.1, 0.3], [1.0, 0.0, 0.0, 0.0]);
+        s.push(wall.unwrap()).unwrap();
+        s
+    }
+
+    fn cost(scene: &Scene<4>, x: &[Joints<f32>; H], guide: &Guide, t: u16) -> f32 {
+        let config = CostConfig {
+            kind: guide.cost,
+            inflation: guide.inflation(t),
+            cylinder: CylinderBox::Enclosing,
+        };
+        trajectory_cost(scene, x, &config, None).unwrap()
+    }
+
+    #[test]
+    fn every_guide_lowers_its_own_cost_and_keeps_the_ends() {
+        let scene = scene();
+        let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let b = [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        for guide in &EDMP_GUIDES {
+            let t = 30;
+            let mut rows = [line(a, b)];
+            let before = cost(&scene, &rows[0], guide, t);
+            assert!(before > 0.0, "guide {} sees the wall", guide.id);
+            let mut grads = [[[0.0; 7]; H]];
+            // Small steps: the same direction, scaled down so the first-order decrease shows.
+            let small = Guide {
+                step: crate::guides::Schedule::Constant(1e-3),
+                ..*guide
+            };
+            guide_step(&scene, &mut rows, &mut grads, &[small], t, CylinderBox::Enclosing).unwrap();
+            let after = cost(&scene, &rows[0], guide, t);
+            assert!(after < before, "guide {}: {before} → {after}", guide.id);
+            assert_eq!(rows[0][0], a);
+            assert_eq!(rows[0][H - 1], b);
+        }
+    }
+
+    #[test]
+    fn a_zero_gradient_is_no_step_not_nan() {
+        let empty = Scene::<4>::new();
+        let a = [0.0, -0.5, 0.0, -2.0, 0.0, 1.6, 0.7];
+        let b = [0.5, -0.2, 0.1, -1.8, 0.0, 1.8, 0.7];
+        let mut rows = [line(a, b); 24];
+        let before = rows;
+        let mut grads = [[[0.0; 7]; H]; 24];
+        guide_step(&empty, &mut rows, &mut grads, &EDMP_GUIDES, 100, CylinderBox::Enclosing).unwrap();
+        assert_eq!(rows, before);
+    }
+
+    #[test]
+    fn the_gradient_is_taken_at_the_clipped_state() {
+        // Joint 7 far above its limit: the clipped row is what the cost sees.
+        let scene = scene();
+        let guide = Guide {
+            id: 0,
+            cost: CostKind::Swept,
+            clearance: crate::guides::Schedule::Constant(0.0),
+            expansion: crate::guides::Schedule::Constant(0.0),
+            normalize: true,
+            step: crate::guides::Schedule::Constant(0.01),
+        };
+        let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let b = [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let mut wild = line(a, b);
+        for q in &mut wild[1..H - 1] {
+            q[6] = 10.0;
+        }
+        let mut clipped = wild;
+        for q in &mut clipped {
+            q[6] = q[6].min(PANDA.hard_upper[6]);
+        }
+        let (mut g1, mut g2) = ([[[0.0; 7]; H]], [[[0.0; 7]; H]]);
+        let (mut r1, mut r2) = ([wild], [clipped]);
+        guide_step(&scene, &mut r1, &mut g1, &[guide], 50, CylinderBox::Enclosing).unwrap();
+        guide_step(&scene, &mut r2, &mut g2, &[guide], 50, CylinderBox::Enclosing).unwrap();
+        assert_eq!(g1, g2);
+        assert!(
+            g1[0][1..H - 1].iter().flatten().any(|g| *g != 0.0),
+            "the clipped sweep touches the wall"
+        );
+        // Applied to the unclipped state.
+        assert!((r1[0][5][6] - (10.0 - (clipped[5][6] - r2[0][5][6]))).abs() < 1e-5);
+    }
+
+    #[test]
+    fn uneven_batches_are_refused() {
+        let mut rows = [[[0.0f32; 7]; H]; 5];
+        let mut grads = [[[0.0f32; 7]; H]; 5];
+        let err = guide_step(
+            &Scene::<4>::new(),
+            &mut rows,
+            &mut grads,
+            &EDMP_GUIDES,
+            10,
+            CylinderBox::Enclosing,
+        );
+        assert_eq!(err, Err(Error::BadParameter));
+        let mut short = [[[0.0f32; 7]; H]; 11];
+        let mut twelve = [[[0.0f32; 7]; H]; 12];
+        let err = guide_step(
+            &Scene::<4>::new(),
+            &mut twelve,
+            &mut short,
+            &EDMP_GUIDES,
+            10,
+            CylinderBox::Enclosing,
+        );
+        assert_eq!(err, Err(Error::BadParameter));
+    }
+}
