@@ -28,6 +28,7 @@ pub mod guidance;
 pub mod guides;
 pub mod ik;
 pub mod kinematics;
+pub mod planner;
 pub mod prior;
 pub mod rng;
 pub mod robot;

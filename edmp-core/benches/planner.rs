@@ -1,0 +1,56 @@
+//! One guided plan (EDMP's 12 guides, one row each) on the wall example, at a few step counts.
+//! Run: `cargo bench -p edmp-core --bench planner`.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use edmp_core::checker::CheckConfig;
+use edmp_core::geometry::CylinderBox;
+use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
+use edmp_core::prior::{Sampler, Scratch};
+use edmp_core::rng::Rng;
+use edmp_core::scene::{Obstacle, Scene};
+
+fn bench(c: &mut Criterion) {
+    let mut scene = Scene::<8>::new();
+    scene
+        .push(Obstacle::cuboid([0.5, 0.0, -0.01], [1.2, 1.6, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())
+        .unwrap();
+    scene
+        .push(Obstacle::cuboid([0.55, 0.0, 0.45], [0.3, 0.02, 0.5], [1.0, 0.0, 0.0, 0.0]).unwrap())
+        .unwrap();
+    let start = [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
+    let goal = [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
+    let mut scratch = Box::new(Scratch::<4>::new());
+    let mut work = Box::new(Workspace::<12>::new());
+    let mut group = c.benchmark_group("planner");
+    group.sample_size(10);
+    for (k, per_step) in [(5u16, 8u8), (10, 4), (25, 2)] {
+        let config = PlanConfig {
+            sampler: Sampler::Strided { steps: k },
+            guidance: GuidanceSchedule::Every { per_step },
+            cylinder: CylinderBox::Enclosing,
+            check: CheckConfig::default(),
+        };
+        group.bench_function(
+            format!("wall, 12 guides, strided K={k}, {per_step} gradient steps per step"),
+            |b| {
+                b.iter(|| {
+                    plan(
+                        &scene,
+                        &start,
+                        &goal,
+                        &EDMP_GUIDES,
+                        &config,
+                        &mut Rng::new(1),
+                        &mut scratch,
+                        &mut work,
+                    )
+                })
+            },
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,298 @@
+//! EDMP's Algorithm 2 on a fixed batch: denoise `B` trajectories together, after each denoising
+//! step let every row follow its guide, then judge every candidate with the exact checker and
+//! keep the free one with the lowest swept volume.
+//!
+//! Fixed work: the number of network forwards, cost gradients and checker states is set by the
+//! sampler, the guidance schedule and `B` (the checker's states by the path length, at most
+//! `MAX_STEPS_PER_SEGMENT` per segment), never by the scene's luck.
+
+use crate::checker::{CheckConfig, check_trajectory};
+use crate::cost::{CostConfig, CostKind, trajectory_cost};
+use crate::error::Error;
+use crate::geometry::{CylinderBox, Inflation};
+use crate::guidance::guide_step;
+use crate::guides::Guide;
+use crate::kinematics::Joints;
+use crate::prior::{HORIZON, Path, Sampler, Scratch, TimeEmbedding, initial_noise, predict_noise};
+use crate::rng::Rng;
+use crate::robot::{JOINTS, PANDA};
+use crate::scene::Scene;
+
+/// When guidance runs and how often.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GuidanceSchedule {
+    /// The original: one gradient step after every denoising step with an even t ≥ 6 (125 of
+    /// the 255 ancestral steps).
+    EvenSteps,
+    /// `per_step` gradient steps after every denoising step with t ≥ 5 (for strided samplers,
+    /// whose steps each stand for several of the original's).
+    Every {
+        /// Gradient steps per denoising step.
+        per_step: u8,
+    },
+}
+
+impl GuidanceSchedule {
+    /// Gradient steps after the denoising step at `t`.
+    pub fn steps_at(&self, t: u16) -> u8 {
+        match *self {
+            Self::EvenSteps => u8::from(t % 2 == 0 && t >= 6),
+            Self::Every { per_step } => {
+                if t >= 5 {
+                    per_step
+                } else {
+                    0
+                }
+            }
+        }
+    }
+}
+
+/// Everything the planner needs besides the scene and the ends.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanConfig {
+    /// How the prior walks from noise to trajectories.
+    pub sampler: Sampler,
+    /// When the guides act.
+    pub guidance: GuidanceSchedule,
+    /// How cylinders are boxed for the costs.
+    pub cylinder: CylinderBox,
+    /// The exact checker's settings for the final judgement.
+    pub check: CheckConfig,
+}
+
+/// One candidate's verdict.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Verdict {
+    /// Swept volume of the final trajectory against the uninflated obstacles (m³·segments).
+    pub swept: f32,
+    /// States the exact checker found in contact (0: free).
+    pub colliding_states: u32,
+}
+
+/// The planner's output: every candidate (row `r` followed guide `r / k`), its verdict, and the
+/// chosen one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan<const B: usize> {
+    /// The candidates, each inside the soft joint limits, starting at the start and ending at
+    /// the goal.
+    pub paths: [Path; B],
+    /// The checker's and the swept cost's verdict on each.
+    pub verdicts: [Verdict; B],
+    /// Index of the chosen candidate: the free one with the lowest swept volume (lowest index on
+    /// ties), or, if none is free, the one with the fewest colliding states (then swept volume).
+    pub best: usize,
+}
+
+impl<const B: usize> Plan<B> {
+    /// Whether the chosen candidate passed the exact checker.
+    pub fn is_free(&self) -> bool {
+        self.verdicts[self.best].colliding_states == 0
+    }
+}
+
+/// Working memory of the planner for `B` rows (gradients and noise predictions).
+#[derive(Clone, Debug)]
+pub struct Workspace<const B: usize> {
+    eps: [Path; B],
+    grads: [Path; B],
+}
+
+impl<const B: usize> Default for Workspace<B> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const B: usize> Workspace<B> {
+    /// Zeroed working memory (`const`: it can live in a `static`).
+    pub const fn new() -> Self {
+        Self {
+            eps: [[[0.0; JOINTS]; HORIZON]; B],
+            grads: [[[0.0; JOINTS]; HORIZON]; B],
+        }
+    }
+}
+
+fn check_joints(q: &Joints<f32>) -> Result<(), Error> {
+    match q.iter().position(|v| !v.is_finite()) {
+        Some(joint) => Err(Error::NonFiniteJoint { joint: joint as u8 }),
+        None => Ok(()),
+    }
+}
+
+/// Plans from `start` to `goal` in `scene` with `B` rows over `guides` (`B` a multiple of
+/// `guides.len()`), drawing every random number from `rng`: the same inputs give the same bits.
+#[allow(clippy::too_many_arguments)]
+pub fn plan<const B: usize, const N: usize, const C: usize>(
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    rng: &mut Rng,
+    scratch: &mut Scratch<C>,
+    work: &mut Workspace<B>,
+) -> Result<Plan<B>, Error> {
+    config.sampler.validate()?;
+    check_joints(start)?;
+    check_joints(goal)?;
+    if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) {
+        return Err(Error::BadParameter);
+    }
+    let mut paths = [[[0.0f32; JOINTS]; HORIZON]; B];
+    for x in paths.iter_mut() {
+        initial_noise(x, rng, start, goal);
+    }
+    for j in 0..config.sampler.evaluations() {
+        let step = config.sampler.step(j);
+        let time = TimeEmbedding::new(step.t)?;
+        predict_noise(&paths, &time, scratch, &mut work.eps)?;
+        for (x, e) in paths.iter_mut().zip(&work.eps) {
+            config.sampler.update(step, x, e, rng, start, goal);
+        }
+        for _ in 0..config.guidance.steps_at(step.t) {
+            guide_step(scene, &mut paths, &mut work.grads, guides, step.t, config.cylinder)?;
+        }
+    }
+
+    let swept = CostConfig {
+        kind: CostKind::Swept,
+        inflation: Inflation::default(),
+        cylinder: config.cylinder,
+    };
+    let mut verdicts = [Verdict {
+        swept: 0.0,
+        colliding_states: 0,
+    }; B];
+    for (x, verdict) in paths.iter_mut().zip(verdicts.iter_mut()) {
+        for q in x.iter_mut() {
+            for (j, v) in q.iter_mut().enumerate() {
+                *v = v.clamp(PANDA.soft_lower[j], PANDA.soft_upper[j]);
+            }
+        }
+        x[0] = *start;
+        x[HORIZON - 1] = *goal;
+        let report = check_trajectory(scene, x, &config.check, false)?;
+        *verdict = Verdict {
+            swept: trajectory_cost(scene, x, &swept, None)?,
+            colliding_states: report.colliding_states,
+        };
+    }
+    let best = (0..B)
+        .min_by(|&a, &b| {
+            let (va, vb) = (verdicts[a], verdicts[b]);
+            va.colliding_states
+                .cmp(&vb.colliding_states)
+                .then(va.swept.total_cmp(&vb.swept))
+                .then(a.cmp(&b))
+        })
+        .unwrap_or(0);
+    Ok(Plan { paths, verdicts, best })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::guides::EDMP_GUIDES;
+    use crate::scene::Obstacle;
+    use std::boxed::Box;
+
+    fn wall_scene() -> Scene<4> {
+        let mut s = Scene::new();
+        s.push(Obstacle::cuboid([0.5, 0.0, -0.01], [1.2, 1.6, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())
+            .unwrap();
+        s.push(Obstacle::cuboid([0.55, 0.0, 0.45], [0.3, 0.02, 0.5], [1.0, 0.0, 0.0, 0.0]).unwrap())
+            .unwrap();
+        s
+    }
+
+    const START: Joints<f32> = [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
+    const GOAL: Joints<f32> = [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
+
+    fn config() -> PlanConfig {
+        PlanConfig {
+            sampler: Sampler::Strided { steps: 10 },
+            guidance: GuidanceSchedule::Every { per_step: 4 },
+            cylinder: CylinderBox::Enclosing,
+            check: CheckConfig::default(),
+        }
+    }
+
+    #[test]
+    fn guided_plans_go_around_a_wall_that_the_straight_line_crosses_and_repeat_bit_for_bit() {
+        let scene = wall_scene();
+        // The straight line collides.
+        let straight: Path = core::array::from_fn(|w| {
+            let s = w as f32 / (HORIZON - 1) as f32;
+            core::array::from_fn(|j| START[j] + s * (GOAL[j] - START[j]))
+        });
+        assert!(
+            !check_trajectory(&scene, &straight, &CheckConfig::default(), true)
+                .unwrap()
+                .is_free()
+        );
+        let mut scratch = Box::new(Scratch::<4>::new());
+        let mut work = Box::new(Workspace::<12>::new());
+        let a = plan(
+            &scene,
+            &START,
+            &GOAL,
+            &EDMP_GUIDES,
+            &config(),
+            &mut Rng::new(1),
+            &mut scratch,
+            &mut work,
+        )
+        .unwrap();
+        assert!(a.is_free(), "{:?}", a.verdicts);
+        let best = &a.paths[a.best];
+        assert_eq!(best[0], START);
+        assert_eq!(best[HORIZON - 1], GOAL);
+        assert!(best.iter().all(|q| PANDA.within_soft_limits(q, 0.0)));
+        let b = plan(
+            &scene,
+            &START,
+            &GOAL,
+            &EDMP_GUIDES,
+            &config(),
+            &mut Rng::new(1),
+            &mut scratch,
+            &mut work,
+        )
+        .unwrap();
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn bad_batches_and_inputs_are_typed_errors() {
+        let scene = wall_scene();
+        let mut scratch = Box::new(Scratch::<1>::new());
+        let mut work = Box::new(Workspace::<5>::new());
+        let err = plan(
+            &scene,
+            &START,
+            &GOAL,
+            &EDMP_GUIDES,
+            &config(),
+            &mut Rng::new(1),
+            &mut scratch,
+            &mut work,
+        );
+        assert_eq!(err.unwrap_err(), Error::BadParameter);
+        let mut work = Box::new(Workspace::<12>::new());
+        let mut nan = GOAL;
+        nan[2] = f32::NAN;
+        let err = plan(
+            &scene,
+            &START,
+            &nan,
+            &EDMP_GUIDES,
+            &config(),
+            &mut Rng::new(1),
+            &mut scratch,
+            &mut work,
+        );
+        assert_eq!(err.unwrap_err(), Error::NonFiniteJoint { joint: 2 });
+    }
+}
