@@ -36,7 +36,7 @@ impl GuidanceSchedule {
     /// Gradient steps after the denoising step at `t`.
     pub fn steps_at(&self, t: u16) -> u8 {
         match *self {
-            Self::EvenSteps => u8::from(t % 2 == 0 && t >= 6),
+            Self::EvenSteps => u8::from(t.is_multiple_of(2) && t >= 6),
             Self::Every { per_step } => {
                 if t >= 5 {
                     per_step
