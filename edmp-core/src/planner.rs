@@ -123,6 +123,7 @@ fn check_joints(q: &Joints<f32>) -> Result<(), Error> {
 
 /// Plans from `start` to `goal` in `scene` with `B` rows over `guides` (`B` a multiple of
 /// `guides.len()`), drawing every random number from `rng`: the same inputs give the same bits.
+/// [`denoise`] then [`select`].
 #[allow(clippy::too_many_arguments)]
 pub fn plan<const B: usize, const N: usize, const C: usize>(
     scene: &Scene<N>,
@@ -134,28 +135,56 @@ pub fn plan<const B: usize, const N: usize, const C: usize>(
     scratch: &mut Scratch<C>,
     work: &mut Workspace<B>,
 ) -> Result<Plan<B>, Error> {
+    let mut paths = [[[0.0f32; JOINTS]; HORIZON]; B];
+    denoise(scene, start, goal, guides, config, rng, scratch, work, &mut paths)?;
+    select(scene, start, goal, config, paths)
+}
+
+/// The guided reverse diffusion: `paths` end as the `B` candidates (not yet clamped or judged).
+#[allow(clippy::too_many_arguments)]
+pub fn denoise<const B: usize, const N: usize, const C: usize>(
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    rng: &mut Rng,
+    scratch: &mut Scratch<C>,
+    work: &mut Workspace<B>,
+    paths: &mut [Path; B],
+) -> Result<(), Error> {
     config.sampler.validate()?;
     check_joints(start)?;
     check_joints(goal)?;
     if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) {
         return Err(Error::BadParameter);
     }
-    let mut paths = [[[0.0f32; JOINTS]; HORIZON]; B];
     for x in paths.iter_mut() {
         initial_noise(x, rng, start, goal);
     }
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
-        predict_noise(&paths, &time, scratch, &mut work.eps)?;
+        predict_noise(paths, &time, scratch, &mut work.eps)?;
         for (x, e) in paths.iter_mut().zip(&work.eps) {
             config.sampler.update(step, x, e, rng, start, goal);
         }
         for _ in 0..config.guidance.steps_at(step.t) {
-            guide_step(scene, &mut paths, &mut work.grads, guides, step.t, config.cylinder)?;
+            guide_step(scene, paths, &mut work.grads, guides, step.t, config.cylinder)?;
         }
     }
+    Ok(())
+}
 
+/// Clamps every candidate into the soft limits (ends exact), judges it with the exact checker
+/// and the uninflated swept volume, and picks the winner.
+pub fn select<const B: usize, const N: usize>(
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    config: &PlanConfig,
+    mut paths: [Path; B],
+) -> Result<Plan<B>, Error> {
     let swept = CostConfig {
         kind: CostKind::Swept,
         inflation: Inflation::default(),

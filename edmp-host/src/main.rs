@@ -8,6 +8,7 @@ mod bench_rrt;
 mod fk;
 mod gen_data;
 mod json;
+mod plan_cmd;
 mod render;
 mod rrt;
 mod rrt_cmd;
@@ -25,6 +26,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Plan with EDMP (exit 0: collision-free plan, 1: only a colliding plan, 2: bad input).
+    Plan(plan_cmd::Args),
     /// Forward kinematics: world pose of every link frame, collision box and the TCP.
     Fk(fk::Args),
     /// Plan with the RRT-Connect baseline (exit 0: planned, 1: no path, 2: bad input).
@@ -52,6 +55,7 @@ pub(crate) enum Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Plan(args) => plan_cmd::run(&args),
         Command::Fk(args) => fk::run(&args).map_err(Failure::Input),
         Command::Rrt(args) => rrt_cmd::run(&args),
         Command::GenSuite(args) => suite::run(&args).map_err(Failure::Input),

@@ -64,3 +64,63 @@ fn render_writes_a_png() {
     assert_eq!(u32::from_be_bytes([bytes[16], bytes[17], bytes[18], bytes[19]]), 1200);
     assert_eq!(u32::from_be_bytes([bytes[20], bytes[21], bytes[22], bytes[23]]), 600);
 }
+
+#[test]
+fn plan_solves_the_example_deterministically_and_refuses_bad_input() {
+    let dir = std::env::temp_dir().join(format!("edmp-plan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (a, b) = (dir.join("a.json"), dir.join("b.json"));
+    for path in [&a, &b] {
+        let out = edmp_host(&[
+            "plan",
+            "examples/wall.json",
+            "--seed",
+            "1",
+            "--candidates",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    let read = |p: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    let (pa, pb) = (read(&a), read(&b));
+    assert_eq!(pa["format"], "edmp-plan/1");
+    assert_eq!(pa["status"], "success");
+    let w = pa["waypoints"].as_array().unwrap();
+    assert_eq!(w.len(), 50);
+    let row = |v: &serde_json::Value| {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap() as f32)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(row(&w[0]), [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785]);
+    assert_eq!(row(&w[49]), [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785]);
+    assert_eq!(pa["candidates"].as_array().unwrap().len(), 12);
+    // Same scene and seed: the same plan, bit for bit (timings aside).
+    assert_eq!(pa["waypoints"], pb["waypoints"]);
+    assert_eq!(pa["candidates"], pb["candidates"]);
+
+    let bad = dir.join("bad.json");
+    let text = std::fs::read_to_string("../examples/wall.json")
+        .or_else(|_| std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/wall.json")))
+        .unwrap()
+        .replace("\"start\": [0.6,", "\"start\": [9.0,");
+    std::fs::write(&bad, text).unwrap();
+    let out_path = dir.join("never.json");
+    let out = edmp_host(&["plan", bad.to_str().unwrap(), "-o", out_path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("start[0]"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!out_path.exists());
+    let out = edmp_host(&["plan", "examples/wall.json", "--guides", "7"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--guides: no guide 7"));
+    std::fs::remove_dir_all(&dir).ok();
+}

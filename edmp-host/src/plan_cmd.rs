@@ -1,0 +1,198 @@
+//! `edmp-host plan`: EDMP on one `edmp-scene/1` file, written as an `edmp-plan/1` plan
+//! (`shared/spec/formats.md`). Exit 0: the chosen trajectory passed the exact checker; 1: no
+//! candidate did (the least colliding one is written, status "collision"); 2: bad input,
+//! nothing written.
+
+use crate::Failure;
+use crate::json::{Goal, parse_problem};
+use edmp_core::checker::CheckConfig;
+use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
+use edmp_core::geometry::{CylinderBox, Inflation};
+use edmp_core::guides::{EDMP_GUIDES, Guide};
+use edmp_core::ik::{IkConfig, solve};
+use edmp_core::kinematics::Pose;
+use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, denoise, select};
+use edmp_core::prior::{HORIZON, Sampler, Scratch};
+use edmp_core::rng::Rng;
+use edmp_core::scene::rotation_from_wxyz;
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Rows of the batch: EDMP's 12 guides, one trajectory each.
+pub(crate) const ROWS: usize = 12;
+
+/// Arguments of `edmp-host plan`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// The scene and problem (`edmp-scene/1` JSON).
+    scene: PathBuf,
+    /// Write the plan here instead of standard output.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Also write every candidate (multimodal output).
+    #[arg(long)]
+    candidates: bool,
+    /// Denoising steps K of the strided sampler; `255` with `--ancestral` is the original.
+    #[arg(long, default_value_t = 10)]
+    steps: u16,
+    /// Gradient steps of every guide after each denoising step (strided sampler).
+    #[arg(long, default_value_t = 4)]
+    gradient_steps: u8,
+    /// EDMP's original sampler and guidance: 255 ancestral steps, guidance on even t ≥ 6.
+    #[arg(long)]
+    ancestral: bool,
+    /// Use only these guides (the original's numbers, e.g. `11,18`); their count must divide 12.
+    #[arg(long, value_delimiter = ',')]
+    guides: Vec<u8>,
+}
+
+fn chosen_guides(ids: &[u8]) -> Result<Vec<Guide>, Failure> {
+    if ids.is_empty() {
+        return Ok(EDMP_GUIDES.to_vec());
+    }
+    let mut out = Vec::new();
+    for id in ids {
+        let guide = EDMP_GUIDES.iter().find(|g| g.id == *id).ok_or_else(|| {
+            let known: Vec<String> = EDMP_GUIDES.iter().map(|g| g.id.to_string()).collect();
+            Failure::Input(format!("--guides: no guide {id} (EDMP's are {})", known.join(", ")))
+        })?;
+        out.push(*guide);
+    }
+    if !ROWS.is_multiple_of(out.len()) {
+        return Err(Failure::Input(format!(
+            "--guides: {} guides do not divide the {ROWS} rows",
+            out.len()
+        )));
+    }
+    Ok(out)
+}
+
+/// Plans and writes the plan.
+pub(crate) fn run(args: &Args) -> Result<(), Failure> {
+    let began = Instant::now();
+    let text =
+        std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let guides = chosen_guides(&args.guides)?;
+    let config = PlanConfig {
+        sampler: if args.ancestral {
+            Sampler::Ancestral
+        } else {
+            Sampler::Strided { steps: args.steps }
+        },
+        guidance: if args.ancestral {
+            GuidanceSchedule::EvenSteps
+        } else {
+            GuidanceSchedule::Every {
+                per_step: args.gradient_steps,
+            }
+        },
+        cylinder: CylinderBox::Enclosing,
+        check: CheckConfig::default(),
+    };
+    config.sampler.validate().map_err(|_| {
+        Failure::Input(format!(
+            "--steps: {} outside 1..={}",
+            args.steps,
+            edmp_core::prior::STEPS
+        ))
+    })?;
+
+    let ik_began = Instant::now();
+    let goal = match problem.goal {
+        Goal::Joints(q) => q,
+        Goal::Pose { position, quaternion } => {
+            let rotation =
+                rotation_from_wxyz(quaternion).map_err(|e| Failure::Input(format!("goal.pose.quaternion: {e}")))?;
+            let target = Pose {
+                rotation,
+                translation: position.into(),
+            };
+            solve(&target, &problem.start, &problem.scene, &IkConfig::default())
+                .map_err(|e| Failure::Input(format!("goal.pose: unreachable: {e}")))?
+                .joints
+        }
+    };
+    let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
+
+    let mut scratch = Box::new(Scratch::<4>::new());
+    let mut work = Box::new(Workspace::<ROWS>::new());
+    let mut paths = Box::new([[[0.0f32; 7]; HORIZON]; ROWS]);
+    let mut rng = Rng::new(args.seed);
+    let denoise_began = Instant::now();
+    denoise(
+        &problem.scene,
+        &problem.start,
+        &goal,
+        &guides,
+        &config,
+        &mut rng,
+        &mut scratch,
+        &mut work,
+        &mut paths,
+    )
+    .map_err(|e| Failure::Input(format!("planner: {e}")))?;
+    let denoise_ms = denoise_began.elapsed().as_secs_f64() * 1e3;
+    let select_began = Instant::now();
+    let plan = select(&problem.scene, &problem.start, &goal, &config, *paths)
+        .map_err(|e| Failure::Input(format!("planner: {e}")))?;
+    let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
+
+    let best = &plan.paths[plan.best];
+    let iv = CostConfig {
+        kind: CostKind::Intersection,
+        inflation: Inflation::default(),
+        cylinder: config.cylinder,
+    };
+    let intersection = trajectory_cost(&problem.scene, best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
+    let per_guide = ROWS / guides.len();
+    let guide_of = |row: usize| guides[row / per_guide].id;
+    let status = if plan.is_free() { "success" } else { "collision" };
+    let mut out = json!({
+        "format": "edmp-plan/1",
+        "status": status,
+        "waypoints": best.iter().map(|q| q.to_vec()).collect::<Vec<_>>(),
+        "guide": guide_of(plan.best),
+        "costs": {"swept_volume": plan.verdicts[plan.best].swept, "intersection_volume": intersection},
+        "seed": args.seed,
+        "timing_ms": {
+            "total": began.elapsed().as_secs_f64() * 1e3,
+            "ik": ik_ms,
+            "denoise": denoise_ms,
+            "select": select_ms,
+        },
+    });
+    if args.candidates {
+        out["candidates"] = plan
+            .paths
+            .iter()
+            .zip(&plan.verdicts)
+            .enumerate()
+            .map(|(row, (path, verdict))| {
+                json!({
+                    "guide": guide_of(row),
+                    "collision_free": verdict.colliding_states == 0,
+                    "swept_volume": verdict.swept,
+                    "waypoints": path.iter().map(|q| q.to_vec()).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+    }
+    let text = serde_json::to_string_pretty(&out).map_err(|e| Failure::Input(e.to_string()))? + "\n";
+    match &args.output {
+        Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?,
+        None => print!("{text}"),
+    }
+    if plan.is_free() {
+        Ok(())
+    } else {
+        Err(Failure::NoPath(format!(
+            "no collision-free candidate; wrote the least colliding one ({} colliding states)",
+            plan.verdicts[plan.best].colliding_states
+        )))
+    }
+}
