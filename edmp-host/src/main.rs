@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod bench_plan;
 mod bench_rrt;
 mod fk;
 mod gen_data;
@@ -34,6 +35,8 @@ enum Command {
     Rrt(rrt_cmd::Args),
     /// Generate the benchmark suite: MpiNets-style scenes and solvable problems.
     GenSuite(suite::Args),
+    /// Run EDMP over a problem folder and print a table per family.
+    BenchPlan(bench_plan::Args),
     /// Run RRT-Connect over a problem folder and print a table per family.
     BenchRrt(bench_rrt::Args),
     /// Generate training trajectories (RRT-Connect in generated scenes) as a `.npy` file.
@@ -59,6 +62,7 @@ fn main() -> ExitCode {
         Command::Fk(args) => fk::run(&args).map_err(Failure::Input),
         Command::Rrt(args) => rrt_cmd::run(&args),
         Command::GenSuite(args) => suite::run(&args).map_err(Failure::Input),
+        Command::BenchPlan(args) => bench_plan::run(&args),
         Command::BenchRrt(args) => bench_rrt::run(&args).map_err(Failure::Input),
         Command::GenData(args) => gen_data::run(&args).map_err(Failure::Input),
         Command::Render(args) => render::run(&args).map_err(Failure::Input),

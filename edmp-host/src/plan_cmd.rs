@@ -4,14 +4,14 @@
 //! nothing written.
 
 use crate::Failure;
-use crate::json::{Goal, parse_problem};
+use crate::json::{Goal, Problem, parse_problem};
 use edmp_core::checker::CheckConfig;
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{CylinderBox, Inflation};
 use edmp_core::guides::{EDMP_GUIDES, Guide};
 use edmp_core::ik::{IkConfig, solve};
 use edmp_core::kinematics::Pose;
-use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, denoise, select};
+use edmp_core::planner::{GuidanceSchedule, Plan, PlanConfig, Workspace, denoise, select};
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
 use edmp_core::scene::rotation_from_wxyz;
@@ -36,7 +36,17 @@ pub(crate) struct Args {
     /// Also write every candidate (multimodal output).
     #[arg(long)]
     candidates: bool,
-    /// Denoising steps K of the strided sampler; `255` with `--ancestral` is the original.
+    /// Use only these guides (the original's numbers, e.g. `11,18`); their count must divide 12.
+    #[arg(long, value_delimiter = ',')]
+    guides: Vec<u8>,
+    #[command(flatten)]
+    tuning: Tuning,
+}
+
+/// The planner's knobs, shared by `plan` and `bench-plan`.
+#[derive(Debug, Clone, clap::Args)]
+pub(crate) struct Tuning {
+    /// Denoising steps K of the strided sampler.
     #[arg(long, default_value_t = 10)]
     steps: u16,
     /// Gradient steps of every guide after each denoising step (strided sampler).
@@ -45,12 +55,115 @@ pub(crate) struct Args {
     /// EDMP's original sampler and guidance: 255 ancestral steps, guidance on even t ≥ 6.
     #[arg(long)]
     ancestral: bool,
-    /// Use only these guides (the original's numbers, e.g. `11,18`); their count must divide 12.
-    #[arg(long, value_delimiter = ',')]
-    guides: Vec<u8>,
 }
 
-fn chosen_guides(ids: &[u8]) -> Result<Vec<Guide>, Failure> {
+impl Tuning {
+    /// The core's configuration, or the bad flag.
+    pub(crate) fn config(&self) -> Result<PlanConfig, Failure> {
+        let config = PlanConfig {
+            sampler: if self.ancestral {
+                Sampler::Ancestral
+            } else {
+                Sampler::Strided { steps: self.steps }
+            },
+            guidance: if self.ancestral {
+                GuidanceSchedule::EvenSteps
+            } else {
+                GuidanceSchedule::Every {
+                    per_step: self.gradient_steps,
+                }
+            },
+            cylinder: CylinderBox::Enclosing,
+            check: CheckConfig::default(),
+        };
+        config.sampler.validate().map_err(|_| {
+            Failure::Input(format!(
+                "--steps: {} outside 1..={}",
+                self.steps,
+                edmp_core::prior::STEPS
+            ))
+        })?;
+        Ok(config)
+    }
+
+    /// A short label for tables.
+    pub(crate) fn label(&self) -> String {
+        if self.ancestral {
+            "ancestral K = 255, guidance on even t".to_owned()
+        } else {
+            format!(
+                "strided K = {}, {} gradient steps per step",
+                self.steps, self.gradient_steps
+            )
+        }
+    }
+}
+
+/// A planned problem and where the time went.
+pub(crate) struct Planned {
+    /// Candidates, verdicts, the winner.
+    pub(crate) plan: Plan<ROWS>,
+    /// Milliseconds in IK, in the guided denoising, in the selection.
+    pub(crate) ik_ms: f64,
+    pub(crate) denoise_ms: f64,
+    pub(crate) select_ms: f64,
+}
+
+/// Plans a parsed problem: IK for a pose goal, then the core planner with `ROWS` rows.
+pub(crate) fn plan_problem(
+    problem: &Problem,
+    guides: &[Guide],
+    config: &PlanConfig,
+    seed: u64,
+) -> Result<Planned, Failure> {
+    let ik_began = Instant::now();
+    let goal = match problem.goal {
+        Goal::Joints(q) => q,
+        Goal::Pose { position, quaternion } => {
+            let rotation =
+                rotation_from_wxyz(quaternion).map_err(|e| Failure::Input(format!("goal.pose.quaternion: {e}")))?;
+            let target = Pose {
+                rotation,
+                translation: position.into(),
+            };
+            solve(&target, &problem.start, &problem.scene, &IkConfig::default())
+                .map_err(|e| Failure::Input(format!("goal.pose: unreachable: {e}")))?
+                .joints
+        }
+    };
+    let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
+    let mut scratch = Box::new(Scratch::<4>::new());
+    let mut work = Box::new(Workspace::<ROWS>::new());
+    let mut paths = Box::new([[[0.0f32; 7]; HORIZON]; ROWS]);
+    let mut rng = Rng::new(seed);
+    let denoise_began = Instant::now();
+    denoise(
+        &problem.scene,
+        &problem.start,
+        &goal,
+        guides,
+        config,
+        &mut rng,
+        &mut scratch,
+        &mut work,
+        &mut paths,
+    )
+    .map_err(|e| Failure::Input(format!("planner: {e}")))?;
+    let denoise_ms = denoise_began.elapsed().as_secs_f64() * 1e3;
+    let select_began = Instant::now();
+    let plan = select(&problem.scene, &problem.start, &goal, config, *paths)
+        .map_err(|e| Failure::Input(format!("planner: {e}")))?;
+    let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
+    Ok(Planned {
+        plan,
+        ik_ms,
+        denoise_ms,
+        select_ms,
+    })
+}
+
+/// The guides named on the command line (all of EDMP's when none).
+pub(crate) fn chosen_guides(ids: &[u8]) -> Result<Vec<Guide>, Failure> {
     if ids.is_empty() {
         return Ok(EDMP_GUIDES.to_vec());
     }
@@ -78,70 +191,10 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let guides = chosen_guides(&args.guides)?;
-    let config = PlanConfig {
-        sampler: if args.ancestral {
-            Sampler::Ancestral
-        } else {
-            Sampler::Strided { steps: args.steps }
-        },
-        guidance: if args.ancestral {
-            GuidanceSchedule::EvenSteps
-        } else {
-            GuidanceSchedule::Every {
-                per_step: args.gradient_steps,
-            }
-        },
-        cylinder: CylinderBox::Enclosing,
-        check: CheckConfig::default(),
-    };
-    config.sampler.validate().map_err(|_| {
-        Failure::Input(format!(
-            "--steps: {} outside 1..={}",
-            args.steps,
-            edmp_core::prior::STEPS
-        ))
-    })?;
+    let config = args.tuning.config()?;
 
-    let ik_began = Instant::now();
-    let goal = match problem.goal {
-        Goal::Joints(q) => q,
-        Goal::Pose { position, quaternion } => {
-            let rotation =
-                rotation_from_wxyz(quaternion).map_err(|e| Failure::Input(format!("goal.pose.quaternion: {e}")))?;
-            let target = Pose {
-                rotation,
-                translation: position.into(),
-            };
-            solve(&target, &problem.start, &problem.scene, &IkConfig::default())
-                .map_err(|e| Failure::Input(format!("goal.pose: unreachable: {e}")))?
-                .joints
-        }
-    };
-    let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
-
-    let mut scratch = Box::new(Scratch::<4>::new());
-    let mut work = Box::new(Workspace::<ROWS>::new());
-    let mut paths = Box::new([[[0.0f32; 7]; HORIZON]; ROWS]);
-    let mut rng = Rng::new(args.seed);
-    let denoise_began = Instant::now();
-    denoise(
-        &problem.scene,
-        &problem.start,
-        &goal,
-        &guides,
-        &config,
-        &mut rng,
-        &mut scratch,
-        &mut work,
-        &mut paths,
-    )
-    .map_err(|e| Failure::Input(format!("planner: {e}")))?;
-    let denoise_ms = denoise_began.elapsed().as_secs_f64() * 1e3;
-    let select_began = Instant::now();
-    let plan = select(&problem.scene, &problem.start, &goal, &config, *paths)
-        .map_err(|e| Failure::Input(format!("planner: {e}")))?;
-    let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
-
+    let planned = plan_problem(&problem, &guides, &config, args.seed)?;
+    let plan = &planned.plan;
     let best = &plan.paths[plan.best];
     let iv = CostConfig {
         kind: CostKind::Intersection,
@@ -161,9 +214,9 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         "seed": args.seed,
         "timing_ms": {
             "total": began.elapsed().as_secs_f64() * 1e3,
-            "ik": ik_ms,
-            "denoise": denoise_ms,
-            "select": select_ms,
+            "ik": planned.ik_ms,
+            "denoise": planned.denoise_ms,
+            "select": planned.select_ms,
         },
     });
     if args.candidates {
