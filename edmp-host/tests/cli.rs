@@ -124,3 +124,89 @@ fn plan_solves_the_example_deterministically_and_refuses_bad_input() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--guides: no guide 7"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Each bad input: how the example is spoiled, and what standard error must say.
+const BAD_PLAN_INPUTS: &[(&str, &str, &str)] = &[
+    ("not JSON", "{", "not valid JSON"),
+    (
+        "wrong format",
+        r#"{"format": "edmp-scene/2", "obstacles": [], "start": [0,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
+        "format: expected \"edmp-scene/1\"",
+    ),
+    (
+        "unknown field",
+        r#"{"format": "edmp-scene/1", "obstacles": [], "start": [0,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0]}, "speed": 1}"#,
+        "speed: unknown field",
+    ),
+    (
+        "short start",
+        r#"{"format": "edmp-scene/1", "obstacles": [], "start": [0,0,0,-2,0,2], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
+        "start: expected 7 numbers, found 6",
+    ),
+    (
+        "start outside the limits",
+        r#"{"format": "edmp-scene/1", "obstacles": [], "start": [0,0,0,-2,0,2,3.5], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
+        "start[6]",
+    ),
+    (
+        "string in the goal",
+        r#"{"format": "edmp-scene/1", "obstacles": [], "start": [0,0,0,-2,0,2,0], "goal": {"joints": [0,0,"x",-2,0,2,0]}}"#,
+        "goal.joints[2]",
+    ),
+    (
+        "quaternion not unit",
+        r#"{"format": "edmp-scene/1", "obstacles": [{"type": "cuboid", "center": [2,0,0], "dims": [0.1,0.1,0.1], "quaternion": [1,1,0,0]}], "start": [0,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
+        "obstacles[0].quaternion",
+    ),
+    (
+        "negative radius",
+        r#"{"format": "edmp-scene/1", "obstacles": [{"type": "sphere", "center": [2,0,0], "radius": -0.1}], "start": [0,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
+        "obstacles[0].radius",
+    ),
+    (
+        "start in collision",
+        r#"{"format": "edmp-scene/1", "obstacles": [{"type": "sphere", "center": [0,0,0.4], "radius": 0.2}], "start": [0,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
+        "start: in collision",
+    ),
+    (
+        "goal in collision",
+        r#"{"format": "edmp-scene/1", "obstacles": [{"type": "sphere", "center": [0.554,0,0.3], "radius": 0.05}], "start": [0.8,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
+        "goal.joints: in collision",
+    ),
+    (
+        "both goal kinds",
+        r#"{"format": "edmp-scene/1", "obstacles": [], "start": [0,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0], "pose": {"position": [0.5,0,0.5], "quaternion": [0,1,0,0]}}}"#,
+        "goal: expected exactly one of",
+    ),
+    (
+        "unreachable pose",
+        r#"{"format": "edmp-scene/1", "obstacles": [], "start": [0,0,0,-2,0,2,0], "goal": {"pose": {"position": [3,0,0.5], "quaternion": [0,1,0,0]}}}"#,
+        "goal.pose: unreachable",
+    ),
+];
+
+#[test]
+fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
+    let dir = std::env::temp_dir().join(format!("edmp-plan-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let too_many = format!(
+        r#"{{"format": "edmp-scene/1", "obstacles": [{}], "start": [0,0,0,-2,0,2,0], "goal": {{"joints": [0,0,0,-2,0,2,0]}}}}"#,
+        vec![r#"{"type": "sphere", "center": [3,0,0], "radius": 0.1}"#; 65].join(",")
+    );
+    let mut cases: Vec<(&str, String, &str)> = BAD_PLAN_INPUTS
+        .iter()
+        .map(|(n, t, m)| (*n, t.to_string(), *m))
+        .collect();
+    cases.push(("too many obstacles", too_many, "obstacles: 65 obstacles, at most 64"));
+    for (name, text, message) in cases {
+        let scene = dir.join("scene.json");
+        std::fs::write(&scene, text).unwrap();
+        let plan = dir.join("plan.json");
+        let out = edmp_host(&["plan", scene.to_str().unwrap(), "-o", plan.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
+        assert!(stderr.contains(message), "{name}: expected `{message}` in: {stderr}");
+        assert!(!plan.exists(), "{name}: a plan was written");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
