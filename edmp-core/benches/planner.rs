@@ -11,6 +11,14 @@ use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
 
 fn bench(c: &mut Criterion) {
+    println!(
+        "planner memory, 12 rows: Workspace {} B + Plan {} B (its candidates) + network Scratch<1> {} B \
+         (Scratch<4> {} B); stack frames aside",
+        core::mem::size_of::<Workspace<12>>(),
+        core::mem::size_of::<edmp_core::planner::Plan<12>>(),
+        Scratch::<1>::BYTES,
+        Scratch::<4>::BYTES,
+    );
     let mut scene = Scene::<8>::new();
     scene
         .push(Obstacle::cuboid([0.5, 0.0, -0.01], [1.2, 1.6, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())
