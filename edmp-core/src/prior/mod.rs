@@ -122,7 +122,7 @@ impl Sampler {
         start: &[f32; JOINTS],
         goal: &[f32; JOINTS],
     ) {
-        let i = usize::from(step.t).saturating_sub(1).min(STEPS - 1);
+        let i = table_index(step.t);
         match *self {
             Self::Ancestral => {
                 let (a, c, sigma) = (
@@ -141,7 +141,7 @@ impl Sampler {
                 let abar = |t: u16| match t {
                     0 => 1.0,
                     t => {
-                        let s = generated::SQRT_ALPHA_BAR[usize::from(t) - 1];
+                        let s = generated::SQRT_ALPHA_BAR[table_index(t)];
                         s * s
                     }
                 };
@@ -162,7 +162,7 @@ impl Sampler {
                 let (pa, pn) = match step.prev {
                     0 => (1.0, 0.0),
                     p => {
-                        let p = usize::from(p) - 1;
+                        let p = table_index(p);
                         (generated::SQRT_ALPHA_BAR[p], generated::SQRT_ONE_MINUS_ALPHA_BAR[p])
                     }
                 };
@@ -176,6 +176,12 @@ impl Sampler {
         }
         inpaint(x, start, goal);
     }
+}
+
+/// Index of step `t` in the schedule tables; steps outside 1 ..= `STEPS` (a hand-made [`Step`])
+/// take the nearest end instead of panicking.
+fn table_index(t: u16) -> usize {
+    usize::from(t).clamp(1, STEPS) - 1
 }
 
 /// Writes the start and the goal into the first and last waypoints.
@@ -244,6 +250,25 @@ mod tests {
         assert_eq!(Sampler::Ddim { steps: 256 }.validate(), Err(Error::BadParameter));
         assert_eq!(Sampler::Strided { steps: 0 }.validate(), Err(Error::BadParameter));
         assert_eq!(Sampler::Strided { steps: 7 }.step(6), Step { t: 37, prev: 0 });
+        // A hand-made step outside the schedule is clamped, not a panic.
+        let (start, goal) = ([0.0; JOINTS], [0.1; JOINTS]);
+        for sampler in [
+            Sampler::Ancestral,
+            Sampler::Strided { steps: 3 },
+            Sampler::Ddim { steps: 3 },
+        ] {
+            let mut x = [[0.5f32; JOINTS]; HORIZON];
+            let eps = [[0.1f32; JOINTS]; HORIZON];
+            sampler.update(
+                Step { t: 900, prev: 700 },
+                &mut x,
+                &eps,
+                &mut Rng::new(1),
+                &start,
+                &goal,
+            );
+            assert!(x.iter().flatten().all(|v| v.is_finite()));
+        }
     }
 
     #[test]
