@@ -185,6 +185,9 @@ pub fn select<const B: usize, const N: usize>(
     config: &PlanConfig,
     mut paths: [Path; B],
 ) -> Result<Plan<B>, Error> {
+    if B == 0 {
+        return Err(Error::BadParameter);
+    }
     let swept = CostConfig {
         kind: CostKind::Swept,
         inflation: Inflation::default(),
