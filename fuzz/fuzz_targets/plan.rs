@@ -1,0 +1,70 @@
+//! Arbitrary scenes, ends and planner settings through the core planner with a short schedule:
+//! it must return a plan whose every candidate is finite, starts at the start and ends at the
+//! goal, or a typed error; never a panic, never a NaN. The work per input is bounded by the
+//! settings (at most 3 denoising steps, 2 gradient steps each, 12 rows).
+#![no_main]
+
+use edmp_core::checker::CheckConfig;
+use edmp_core::geometry::CylinderBox;
+use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
+use edmp_core::prior::{HORIZON, Sampler, Scratch};
+use edmp_core::rng::Rng;
+use edmp_core::scene::{Obstacle, Scene};
+use libfuzzer_sys::fuzz_target;
+
+struct Reader<'a>(&'a [u8]);
+
+impl Reader<'_> {
+    fn byte(&mut self) -> u8 {
+        let (&b, rest) = self.0.split_first().unwrap_or((&0, &[]));
+        self.0 = rest;
+        b
+    }
+    /// Raw bits half the time (NaN, infinities, huge values), a tame value in [-4, 4) otherwise.
+    fn f32(&mut self) -> f32 {
+        let raw = f32::from_le_bytes([self.byte(), self.byte(), self.byte(), self.byte()]);
+        if self.byte() & 1 == 0 { raw } else { (raw.to_bits() % 8000) as f32 / 1000.0 - 4.0 }
+    }
+    fn array<const M: usize>(&mut self) -> [f32; M] {
+        core::array::from_fn(|_| self.f32())
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let mut r = Reader(data);
+    let count = r.byte() % 5;
+    let mut scene = Scene::<4>::new();
+    for _ in 0..count {
+        let (kind, center, size) = (r.byte(), r.array::<3>(), r.array::<3>());
+        let built = match kind % 3 {
+            0 => Obstacle::cuboid(center, size, [1.0, 0.0, 0.0, 0.0]),
+            1 => Obstacle::cylinder(center, size[0], size[1], [1.0, 0.0, 0.0, 0.0]),
+            _ => Obstacle::sphere(center, size[0]),
+        };
+        if let Ok(o) = built {
+            scene.push(o).expect("capacity 4 holds at most 4");
+        }
+    }
+    let (start, goal) = (r.array::<7>(), r.array::<7>());
+    let steps = u16::from(r.byte() % 4);
+    let config = PlanConfig {
+        sampler: if r.byte() & 1 == 0 { Sampler::Strided { steps } } else { Sampler::Ddim { steps } },
+        guidance: GuidanceSchedule::Every { per_step: r.byte() % 3 },
+        cylinder: CylinderBox::Enclosing,
+        check: CheckConfig::default(),
+    };
+    let guides = &EDMP_GUIDES[..[1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)]];
+    let mut scratch = Box::new(Scratch::<4>::new());
+    let mut work = Box::new(Workspace::<12>::new());
+    let seed = u64::from(r.byte());
+    if let Ok(p) = plan(&scene, &start, &goal, guides, &config, &mut Rng::new(seed), &mut scratch, &mut work) {
+        assert!(steps >= 1);
+        for path in &p.paths {
+            assert!(path.iter().flatten().all(|v| v.is_finite()));
+            assert_eq!(path[0], start);
+            assert_eq!(path[HORIZON - 1], goal);
+        }
+        assert!(p.verdicts.iter().all(|v| v.swept.is_finite() && v.swept >= 0.0));
+    }
+});
