@@ -24,7 +24,11 @@ impl Reader<'_> {
     /// Raw bits half the time (NaN, infinities, huge values), a tame value in [-4, 4) otherwise.
     fn f32(&mut self) -> f32 {
         let raw = f32::from_le_bytes([self.byte(), self.byte(), self.byte(), self.byte()]);
-        if self.byte() & 1 == 0 { raw } else { (raw.to_bits() % 8000) as f32 / 1000.0 - 4.0 }
+        if self.byte() & 1 == 0 {
+            raw
+        } else {
+            (raw.to_bits() % 8000) as f32 / 1000.0 - 4.0
+        }
     }
     fn array<const M: usize>(&mut self) -> [f32; M] {
         core::array::from_fn(|_| self.f32())
@@ -49,7 +53,11 @@ fuzz_target!(|data: &[u8]| {
     let (start, goal) = (r.array::<7>(), r.array::<7>());
     let steps = u16::from(r.byte() % 4);
     let config = PlanConfig {
-        sampler: if r.byte() & 1 == 0 { Sampler::Strided { steps } } else { Sampler::Ddim { steps } },
+        sampler: if r.byte() & 1 == 0 {
+            Sampler::Strided { steps }
+        } else {
+            Sampler::Ddim { steps }
+        },
         guidance: GuidanceSchedule::Every { per_step: r.byte() % 3 },
         cylinder: CylinderBox::Enclosing,
         check: CheckConfig::default(),
@@ -58,7 +66,16 @@ fuzz_target!(|data: &[u8]| {
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<12>::new());
     let seed = u64::from(r.byte());
-    if let Ok(p) = plan(&scene, &start, &goal, guides, &config, &mut Rng::new(seed), &mut scratch, &mut work) {
+    if let Ok(p) = plan(
+        &scene,
+        &start,
+        &goal,
+        guides,
+        &config,
+        &mut Rng::new(seed),
+        &mut scratch,
+        &mut work,
+    ) {
         assert!(steps >= 1);
         for path in &p.paths {
             assert!(path.iter().flatten().all(|v| v.is_finite()));
