@@ -43,12 +43,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     let guides = chosen_guides(&args.guides)?;
     let config = args.tuning.config()?;
     let input = |e: String| Failure::Input(e);
-    let mut families: Vec<PathBuf> = std::fs::read_dir(&args.problems)
-        .map_err(|e| input(format!("{}: {e}", args.problems.display())))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_dir())
-        .collect();
-    families.sort();
+    let families = crate::suite::read_folder(&args.problems, args.per_family).map_err(input)?;
     let ids: Vec<String> = guides.iter().map(|g| g.id.to_string()).collect();
     println!(
         "EDMP, guides {} ({} rows), {}, seed {}\n",
@@ -60,18 +55,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     println!("| family | solved | median time (ms) | p95 time (ms) |");
     println!("|---|---|---|---|");
     let (mut all_ok, mut all_n, mut all_times) = (0, 0, Vec::new());
-    for dir in families {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-            .map_err(|e| input(format!("{}: {e}", dir.display())))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x == "json"))
-            .collect();
-        files.sort();
-        files.truncate(args.per_family);
-        let name = dir
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
+    for (name, files) in families {
         let bar = ProgressBar::new(files.len() as u64).with_message(name.clone());
         bar.set_style(
             ProgressStyle::with_template("{msg:>13} [{bar:40}] {pos}/{len}").map_err(|e| input(e.to_string()))?,

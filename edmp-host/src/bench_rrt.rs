@@ -58,29 +58,14 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 
 /// Runs the benchmark and prints the table.
 pub(crate) fn run(args: &Args) -> Result<(), String> {
-    let mut families: Vec<PathBuf> = std::fs::read_dir(&args.problems)
-        .map_err(|e| format!("{}: {e}", args.problems.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_dir())
-        .collect();
-    families.sort();
+    let families = crate::suite::read_folder(&args.problems, usize::MAX)?;
     let budget = Duration::from_millis(args.budget_ms);
     println!(
         "| family | solved (≤ {} ms) | median time (ms) | p95 time (ms) | mean path length (rad) |",
         args.budget_ms
     );
     println!("|---|---|---|---|---|");
-    for dir in families {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-            .map_err(|e| format!("{}: {e}", dir.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x == "json"))
-            .collect();
-        files.sort();
-        let name = dir
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
+    for (name, files) in families {
         let bar = ProgressBar::new(files.len() as u64).with_message(name.clone());
         bar.set_style(ProgressStyle::with_template("{msg:>13} [{bar:40}] {pos}/{len}").map_err(|e| e.to_string())?);
         let one = |f: &PathBuf| {

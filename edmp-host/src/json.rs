@@ -2,9 +2,10 @@
 //! offending field by its JSON path, e.g. `obstacles[3].quaternion: norm 0.71, expected 1`.
 
 use edmp_core::checker::{CheckConfig, Contact, check_state};
-use edmp_core::kinematics::Joints;
+use edmp_core::ik::{IkConfig, solve};
+use edmp_core::kinematics::{Joints, Pose};
 use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS, PANDA};
-use edmp_core::scene::{MAX_OBSTACLES, Obstacle, QUATERNION_NORM_TOLERANCE, Scene, SceneError};
+use edmp_core::scene::{MAX_OBSTACLES, Obstacle, QUATERNION_NORM_TOLERANCE, Scene, SceneError, rotation_from_wxyz};
 use serde_json::{Map, Value};
 use std::fmt;
 
@@ -187,6 +188,24 @@ fn describe(contact: Contact) -> String {
     match contact {
         Contact::Obstacle { body: b, obstacle } => format!("{} touches obstacles[{obstacle}]", body(b)),
         Contact::SelfContact { first, second } => format!("{} touches {}", body(first), body(second)),
+    }
+}
+
+/// The problem's goal as joints: itself for a joint goal, the core IK's collision-free solution
+/// nearest the start for a pose goal. The error names the field.
+pub(crate) fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
+    match problem.goal {
+        Goal::Joints(q) => Ok(q),
+        Goal::Pose { position, quaternion } => {
+            let rotation = rotation_from_wxyz(quaternion).map_err(|e| format!("goal.pose.quaternion: {e}"))?;
+            let target = Pose {
+                rotation,
+                translation: position.into(),
+            };
+            solve(&target, &problem.start, &problem.scene, &IkConfig::default())
+                .map(|s| s.joints)
+                .map_err(|e| format!("goal.pose: unreachable: {e}"))
+        }
     }
 }
 

@@ -4,17 +4,14 @@
 //! nothing written.
 
 use crate::Failure;
-use crate::json::{Goal, Problem, parse_problem};
+use crate::json::{Problem, joint_goal, parse_problem};
 use edmp_core::checker::CheckConfig;
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{CylinderBox, Inflation};
 use edmp_core::guides::{EDMP_GUIDES, Guide};
-use edmp_core::ik::{IkConfig, solve};
-use edmp_core::kinematics::Pose;
 use edmp_core::planner::{GuidanceSchedule, Plan, PlanConfig, Workspace, denoise, select};
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
-use edmp_core::scene::rotation_from_wxyz;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -117,20 +114,7 @@ pub(crate) fn plan_problem(
     seed: u64,
 ) -> Result<Planned, Failure> {
     let ik_began = Instant::now();
-    let goal = match problem.goal {
-        Goal::Joints(q) => q,
-        Goal::Pose { position, quaternion } => {
-            let rotation =
-                rotation_from_wxyz(quaternion).map_err(|e| Failure::Input(format!("goal.pose.quaternion: {e}")))?;
-            let target = Pose {
-                rotation,
-                translation: position.into(),
-            };
-            solve(&target, &problem.start, &problem.scene, &IkConfig::default())
-                .map_err(|e| Failure::Input(format!("goal.pose: unreachable: {e}")))?
-                .joints
-        }
-    };
+    let goal = joint_goal(problem).map_err(Failure::Input)?;
     let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<ROWS>::new());

@@ -2,12 +2,9 @@
 //! `edmp-plan/1` plan (status "success" only: without a path nothing is written, exit 1).
 
 use crate::Failure;
-use crate::json::{Goal, parse_problem};
+use crate::json::{joint_goal, parse_problem};
 use crate::rrt::{RrtConfig, RrtError, path_length, plan};
 use core::time::Duration;
-use edmp_core::ik::{IkConfig, solve};
-use edmp_core::kinematics::Pose;
-use edmp_core::scene::rotation_from_wxyz;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -34,20 +31,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     let text =
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
-    let goal = match problem.goal {
-        Goal::Joints(q) => q,
-        Goal::Pose { position, quaternion } => {
-            let rotation =
-                rotation_from_wxyz(quaternion).map_err(|e| Failure::Input(format!("goal.pose.quaternion: {e}")))?;
-            let target = Pose {
-                rotation,
-                translation: position.into(),
-            };
-            solve(&target, &problem.start, &problem.scene, &IkConfig::default())
-                .map_err(|e| Failure::Input(format!("goal.pose: {e}")))?
-                .joints
-        }
-    };
+    let goal = joint_goal(&problem).map_err(Failure::Input)?;
     let config = RrtConfig {
         budget: Duration::from_millis(args.budget_ms),
         ..RrtConfig::default()

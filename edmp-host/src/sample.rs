@@ -185,20 +185,8 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
         return Err("--samplers: give at least one".into());
     }
     let mut problems = Vec::new();
-    let mut families: Vec<PathBuf> = std::fs::read_dir(&args.problems)
-        .map_err(|e| format!("{}: {e}", args.problems.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_dir())
-        .collect();
-    families.sort();
-    for family in &families {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(family)
-            .map_err(|e| format!("{}: {e}", family.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x == "json"))
-            .collect();
-        files.sort();
-        for path in files.into_iter().take(args.per_family) {
+    for (_, files) in crate::suite::read_folder(&args.problems, args.per_family)? {
+        for path in files {
             let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let p = parse_problem(&text).map_err(|e| format!("{}: {e}", path.display()))?;
             let Goal::Joints(goal) = p.goal else {

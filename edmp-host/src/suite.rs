@@ -9,6 +9,33 @@ use crate::scenes::{Family, Kind, Problem, problem};
 use core::time::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
+/// A problem folder as written by `gen-suite`: each family's name and its first `per_family`
+/// `.json` files, families and files in name order.
+pub(crate) fn read_folder(root: &std::path::Path, per_family: usize) -> Result<Vec<(String, Vec<PathBuf>)>, String> {
+    let list = |dir: &std::path::Path| -> Result<Vec<PathBuf>, String> {
+        let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|e| format!("{}: {e}", dir.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .collect();
+        paths.sort();
+        Ok(paths)
+    };
+    let mut out = Vec::new();
+    for dir in list(root)?.into_iter().filter(|p| p.is_dir()) {
+        let name = dir
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let mut files: Vec<PathBuf> = list(&dir)?
+            .into_iter()
+            .filter(|p| p.extension().is_some_and(|x| x == "json"))
+            .collect();
+        files.truncate(per_family);
+        out.push((name, files));
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 use std::path::Path;
 use std::path::PathBuf;
