@@ -251,6 +251,24 @@ mod tests {
         }
     }
 
+    /// `plan` with EDMP's guides, the test config and seed 1.
+    fn plan_wall<const B: usize, const C: usize>(
+        goal: &Joints<f32>,
+        scratch: &mut Scratch<C>,
+        work: &mut Workspace<B>,
+    ) -> Result<Plan<B>, Error> {
+        plan(
+            &wall_scene(),
+            &START,
+            goal,
+            &EDMP_GUIDES,
+            &config(),
+            &mut Rng::new(1),
+            scratch,
+            work,
+        )
+    }
+
     #[test]
     fn guided_plans_go_around_a_wall_that_the_straight_line_crosses_and_repeat_bit_for_bit() {
         let scene = wall_scene();
@@ -266,65 +284,26 @@ mod tests {
         );
         let mut scratch = Box::new(Scratch::<4>::new());
         let mut work = Box::new(Workspace::<12>::new());
-        let a = plan(
-            &scene,
-            &START,
-            &GOAL,
-            &EDMP_GUIDES,
-            &config(),
-            &mut Rng::new(1),
-            &mut scratch,
-            &mut work,
-        )
-        .unwrap();
+        let a = plan_wall(&GOAL, &mut scratch, &mut work).unwrap();
         assert!(a.is_free(), "{:?}", a.verdicts);
         let best = &a.paths[a.best];
         assert_eq!(best[0], START);
         assert_eq!(best[HORIZON - 1], GOAL);
         assert!(best.iter().all(|q| PANDA.within_soft_limits(q, 0.0)));
-        let b = plan(
-            &scene,
-            &START,
-            &GOAL,
-            &EDMP_GUIDES,
-            &config(),
-            &mut Rng::new(1),
-            &mut scratch,
-            &mut work,
-        )
-        .unwrap();
+        let b = plan_wall(&GOAL, &mut scratch, &mut work).unwrap();
         assert_eq!(a, b);
     }
 
     #[test]
     fn bad_batches_and_inputs_are_typed_errors() {
-        let scene = wall_scene();
         let mut scratch = Box::new(Scratch::<1>::new());
         let mut work = Box::new(Workspace::<5>::new());
-        let err = plan(
-            &scene,
-            &START,
-            &GOAL,
-            &EDMP_GUIDES,
-            &config(),
-            &mut Rng::new(1),
-            &mut scratch,
-            &mut work,
-        );
+        let err = plan_wall(&GOAL, &mut scratch, &mut work);
         assert_eq!(err.unwrap_err(), Error::BadParameter);
         let mut work = Box::new(Workspace::<12>::new());
         let mut nan = GOAL;
         nan[2] = f32::NAN;
-        let err = plan(
-            &scene,
-            &START,
-            &nan,
-            &EDMP_GUIDES,
-            &config(),
-            &mut Rng::new(1),
-            &mut scratch,
-            &mut work,
-        );
+        let err = plan_wall(&nan, &mut scratch, &mut work);
         assert_eq!(err.unwrap_err(), Error::NonFiniteJoint { joint: 2 });
     }
 }
