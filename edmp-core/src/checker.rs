@@ -44,13 +44,18 @@ pub struct CheckConfig {
     pub self_collision: bool,
 }
 
+impl CheckConfig {
+    /// The project's definition of a solved problem (`shared/spec/formats.md`).
+    pub const DEFAULT: Self = Self {
+        margin: DEFAULT_MARGIN,
+        max_step: MAX_JOINT_STEP,
+        self_collision: true,
+    };
+}
+
 impl Default for CheckConfig {
     fn default() -> Self {
-        Self {
-            margin: DEFAULT_MARGIN,
-            max_step: MAX_JOINT_STEP,
-            self_collision: true,
-        }
+        Self::DEFAULT
     }
 }
 

@@ -84,10 +84,52 @@ pub struct Plan<const B: usize> {
     pub best: usize,
 }
 
+/// Denoising steps of the shipped configuration ([`PlanConfig::DEFAULT`]).
+pub const DEFAULT_STEPS: u16 = 10;
+
+/// Gradient steps per denoising step of the shipped configuration.
+pub const DEFAULT_GRADIENT_STEPS: u8 = 4;
+
+impl PlanConfig {
+    /// The shipped configuration, picked from the suite measurements in the README: the
+    /// strided sampler with [`DEFAULT_STEPS`] steps, [`DEFAULT_GRADIENT_STEPS`] gradient steps
+    /// after each, enclosing boxes for cylinders, the project's checker.
+    pub const DEFAULT: Self = Self {
+        sampler: Sampler::Strided { steps: DEFAULT_STEPS },
+        guidance: GuidanceSchedule::Every {
+            per_step: DEFAULT_GRADIENT_STEPS,
+        },
+        cylinder: CylinderBox::Enclosing,
+        check: CheckConfig::DEFAULT,
+    };
+}
+
 impl<const B: usize> Plan<B> {
     /// Whether the chosen candidate passed the exact checker.
     pub fn is_free(&self) -> bool {
         self.verdicts[self.best].colliding_states == 0
+    }
+
+    /// FNV-1a (64 bit) over the bits of every candidate, every verdict and the chosen index:
+    /// equal fingerprints on two machines mean the same plan, bit for bit.
+    pub fn fingerprint(&self) -> u64 {
+        let mut hash = 0xcbf2_9ce4_8422_2325u64;
+        let mut eat = |word: u32| {
+            for byte in word.to_le_bytes() {
+                hash = (hash ^ u64::from(byte)).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        };
+        for path in &self.paths {
+            for v in path.iter().flatten() {
+                eat(v.to_bits());
+            }
+        }
+        for verdict in &self.verdicts {
+            eat(verdict.swept.to_bits());
+            eat(verdict.colliding_states);
+        }
+        eat(self.best as u32);
+        hash
     }
 }
 

@@ -9,7 +9,9 @@ use edmp_core::checker::CheckConfig;
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{CylinderBox, Inflation};
 use edmp_core::guides::{EDMP_GUIDES, Guide};
-use edmp_core::planner::{GuidanceSchedule, Plan, PlanConfig, Workspace, denoise, select};
+use edmp_core::planner::{
+    DEFAULT_GRADIENT_STEPS, DEFAULT_STEPS, GuidanceSchedule, Plan, PlanConfig, Workspace, denoise, select,
+};
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
 use serde_json::json;
@@ -44,10 +46,10 @@ pub(crate) struct Args {
 #[derive(Debug, Clone, clap::Args)]
 pub(crate) struct Tuning {
     /// Denoising steps K of the strided sampler.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = DEFAULT_STEPS)]
     steps: u16,
     /// Gradient steps of every guide after each denoising step (strided sampler).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = DEFAULT_GRADIENT_STEPS)]
     gradient_steps: u8,
     /// EDMP's original sampler and guidance: 255 ancestral steps, guidance on even t ≥ 6.
     #[arg(long)]
