@@ -2,8 +2,6 @@
 //! Run: `cargo bench -p edmp-core --bench planner`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use edmp_core::checker::CheckConfig;
-use edmp_core::geometry::CylinderBox;
 use edmp_core::guides::EDMP_GUIDES;
 use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
 use edmp_core::prior::{Sampler, Scratch};
@@ -32,30 +30,42 @@ fn bench(c: &mut Criterion) {
     let mut work = Box::new(Workspace::<12>::new());
     let mut group = c.benchmark_group("planner");
     group.sample_size(10);
-    for (k, per_step) in [(5u16, 8u8), (10, 4), (25, 2)] {
-        let config = PlanConfig {
-            sampler: Sampler::Strided { steps: k },
-            guidance: GuidanceSchedule::Every { per_step },
-            cylinder: CylinderBox::Enclosing,
-            check: CheckConfig::default(),
-        };
-        group.bench_function(
-            format!("wall, 12 guides, strided K={k}, {per_step} gradient steps per step"),
-            |b| {
-                b.iter(|| {
-                    plan(
-                        &scene,
-                        &start,
-                        &goal,
-                        &EDMP_GUIDES,
-                        &config,
-                        &mut Rng::new(1),
-                        &mut scratch,
-                        &mut work,
-                    )
-                })
-            },
-        );
+    let variant = |steps: u16, per_step: u8, refine: u8, step_limit: f32| PlanConfig {
+        sampler: Sampler::Strided { steps },
+        guidance: GuidanceSchedule::Every { per_step },
+        refine,
+        step_limit,
+        ..PlanConfig::DEFAULT
+    };
+    let configs = [
+        (
+            "default (K=5, 8 gradient steps, 16 refinement steps)",
+            PlanConfig::DEFAULT,
+        ),
+        (
+            "K=10, 4 gradient steps, no refinement",
+            variant(10, 4, 0, f32::INFINITY),
+        ),
+        (
+            "K=25, 2 gradient steps, no refinement",
+            variant(25, 2, 0, f32::INFINITY),
+        ),
+    ];
+    for (label, config) in configs {
+        group.bench_function(format!("wall, 12 guides, {label}"), |b| {
+            b.iter(|| {
+                plan(
+                    &scene,
+                    &start,
+                    &goal,
+                    &EDMP_GUIDES,
+                    &config,
+                    &mut Rng::new(1),
+                    &mut scratch,
+                    &mut work,
+                )
+            })
+        });
     }
     group.finish();
 }

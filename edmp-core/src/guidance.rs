@@ -4,7 +4,9 @@
 //! batch). Each gradient is taken at the row clipped to the hard joint limits and applied to the
 //! unclipped row, interior waypoints only (shared/notes/edmp-reference.md §3). Normalized guides
 //! divide by the norm of their own k rows' gradient and skip the step when it is zero: the
-//! original's batch-wide norm couples guides and turns an all-zero gradient into NaN.
+//! original's batch-wide norm couples guides and turns an all-zero gradient into NaN. A step
+//! limit per joint keeps the unnormalized guides (whose step is the raw gradient times ~2)
+//! from throwing a waypoint across the workspace where the costs are steep.
 
 use crate::cost::{CostConfig, trajectory_cost};
 use crate::error::Error;
@@ -14,8 +16,9 @@ use crate::kinematics::Joints;
 use crate::robot::PANDA;
 use crate::scene::Scene;
 
-/// Applies every row's guide once at diffusion step `t`. `grads` is working memory, one entry
-/// per row. Fails with [`Error::BadParameter`] if the rows do not split evenly over the guides or
+/// Applies every row's guide once at diffusion step `t`, no joint of a waypoint moving more
+/// than `step_limit` radians (`f32::INFINITY`: the original's unlimited step). `grads` is
+/// working memory, one entry per row. Fails with [`Error::BadParameter`] if the rows do not split evenly over the guides or
 /// `grads` has another length; non-finite joints and overflowing results are typed errors too,
 /// and then `rows` may be partly updated.
 pub fn guide_step<const H: usize, const N: usize>(
@@ -24,8 +27,12 @@ pub fn guide_step<const H: usize, const N: usize>(
     grads: &mut [[Joints<f32>; H]],
     guides: &[Guide],
     t: u16,
+    step_limit: f32,
     cylinder: CylinderBox,
 ) -> Result<(), Error> {
+    if step_limit.is_nan() || step_limit <= 0.0 {
+        return Err(Error::BadParameter);
+    }
     if guides.is_empty() || !rows.len().is_multiple_of(guides.len()) || grads.len() != rows.len() || H < 3 {
         return Err(Error::BadParameter);
     }
@@ -62,7 +69,7 @@ pub fn guide_step<const H: usize, const N: usize>(
         for (row, grad) in rows.iter_mut().zip(grads.iter()) {
             for (q, g) in row[1..H - 1].iter_mut().zip(&grad[1..H - 1]) {
                 for (qj, gj) in q.iter_mut().zip(g) {
-                    *qj -= scale * gj;
+                    *qj -= (scale * gj).clamp(-step_limit, step_limit);
                 }
             }
             if row.iter().flatten().any(|v| !v.is_finite()) {
@@ -122,7 +129,16 @@ mod tests {
                 step: crate::guides::Schedule::Constant(1e-3),
                 ..*guide
             };
-            guide_step(&scene, &mut rows, &mut grads, &[small], t, CylinderBox::Enclosing).unwrap();
+            guide_step(
+                &scene,
+                &mut rows,
+                &mut grads,
+                &[small],
+                t,
+                f32::INFINITY,
+                CylinderBox::Enclosing,
+            )
+            .unwrap();
             let after = cost(&scene, &rows[0], guide, t);
             assert!(after < before, "guide {}: {before} → {after}", guide.id);
             assert_eq!(rows[0][0], a);
@@ -138,7 +154,16 @@ mod tests {
         let mut rows = [line(a, b); 24];
         let before = rows;
         let mut grads = [[[0.0; 7]; H]; 24];
-        guide_step(&empty, &mut rows, &mut grads, &EDMP_GUIDES, 100, CylinderBox::Enclosing).unwrap();
+        guide_step(
+            &empty,
+            &mut rows,
+            &mut grads,
+            &EDMP_GUIDES,
+            100,
+            f32::INFINITY,
+            CylinderBox::Enclosing,
+        )
+        .unwrap();
         assert_eq!(rows, before);
     }
 
@@ -166,8 +191,26 @@ mod tests {
         }
         let (mut g1, mut g2) = ([[[0.0; 7]; H]], [[[0.0; 7]; H]]);
         let (mut r1, mut r2) = ([wild], [clipped]);
-        guide_step(&scene, &mut r1, &mut g1, &[guide], 50, CylinderBox::Enclosing).unwrap();
-        guide_step(&scene, &mut r2, &mut g2, &[guide], 50, CylinderBox::Enclosing).unwrap();
+        guide_step(
+            &scene,
+            &mut r1,
+            &mut g1,
+            &[guide],
+            50,
+            f32::INFINITY,
+            CylinderBox::Enclosing,
+        )
+        .unwrap();
+        guide_step(
+            &scene,
+            &mut r2,
+            &mut g2,
+            &[guide],
+            50,
+            f32::INFINITY,
+            CylinderBox::Enclosing,
+        )
+        .unwrap();
         assert_eq!(g1, g2);
         assert!(
             g1[0][1..H - 1].iter().flatten().any(|g| *g != 0.0),
@@ -187,6 +230,7 @@ mod tests {
             &mut grads,
             &EDMP_GUIDES,
             10,
+            f32::INFINITY,
             CylinderBox::Enclosing,
         );
         assert_eq!(err, Err(Error::BadParameter));
@@ -198,8 +242,64 @@ mod tests {
             &mut short,
             &EDMP_GUIDES,
             10,
+            f32::INFINITY,
             CylinderBox::Enclosing,
         );
         assert_eq!(err, Err(Error::BadParameter));
+    }
+
+    #[test]
+    fn the_step_limit_bounds_every_joint_move_and_must_be_positive() {
+        // Guide 10 (unnormalized swept volume, step ≈ 1.4) through a wall: long raw steps.
+        let scene = scene();
+        let guide = *EDMP_GUIDES.iter().find(|g| g.id == 10).unwrap();
+        let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let b = [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let mut grads = [[[0.0; 7]; H]];
+        let mut free = [line(a, b)];
+        guide_step(
+            &scene,
+            &mut free,
+            &mut grads,
+            &[guide],
+            200,
+            f32::INFINITY,
+            CylinderBox::Enclosing,
+        )
+        .unwrap();
+        let moved = |rows: &[[Joints<f32>; H]; 1]| {
+            let start = line(a, b);
+            rows[0]
+                .iter()
+                .zip(&start)
+                .flat_map(|(p, q)| p.iter().zip(q).map(|(x, y)| (x - y).abs()))
+                .fold(0.0f32, f32::max)
+        };
+        assert!(moved(&free) > 0.02, "the raw step is long: {}", moved(&free));
+        let mut limited = [line(a, b)];
+        guide_step(
+            &scene,
+            &mut limited,
+            &mut grads,
+            &[guide],
+            200,
+            0.02,
+            CylinderBox::Enclosing,
+        )
+        .unwrap();
+        assert!(moved(&limited) <= 0.02 + 1e-6, "{}", moved(&limited));
+        assert!(moved(&limited) > 0.0);
+        for bad in [0.0, -1.0, f32::NAN] {
+            let err = guide_step(
+                &scene,
+                &mut limited,
+                &mut grads,
+                &[guide],
+                200,
+                bad,
+                CylinderBox::Enclosing,
+            );
+            assert_eq!(err, Err(Error::BadParameter));
+        }
     }
 }

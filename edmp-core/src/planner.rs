@@ -55,6 +55,14 @@ pub struct PlanConfig {
     pub sampler: Sampler,
     /// When the guides act.
     pub guidance: GuidanceSchedule,
+    /// Gradient steps of every guide after the last denoising step, with each guide's schedule
+    /// at t = 1 (no expansion, its own clearance and step size): a deviation from the original,
+    /// which stops at the last denoising step; measured in the README.
+    pub refine: u8,
+    /// Largest move of one joint of one waypoint in one gradient step, radians
+    /// (`f32::INFINITY`: the original, unlimited). A deviation: unlimited, the unnormalized
+    /// swept-volume guide (10) throws trajectories across the workspace; measured in the README.
+    pub step_limit: f32,
     /// How cylinders are boxed for the costs.
     pub cylinder: CylinderBox,
     /// The exact checker's settings for the final judgement.
@@ -66,7 +74,11 @@ pub struct PlanConfig {
 pub struct Verdict {
     /// Swept volume of the final trajectory against the uninflated obstacles (m³·segments).
     pub swept: f32,
-    /// States the exact checker found in contact (0: free).
+    /// Whether the exact checker found no contact anywhere along the trajectory.
+    pub free: bool,
+    /// States the exact checker found in contact. Counted in full only when no candidate is
+    /// free (the fallback ranks by it); otherwise the check of a colliding candidate stops at
+    /// its first contact and this is 1. 0 exactly when `free`.
     pub colliding_states: u32,
 }
 
@@ -85,10 +97,16 @@ pub struct Plan<const B: usize> {
 }
 
 /// Denoising steps of the shipped configuration ([`PlanConfig::DEFAULT`]).
-pub const DEFAULT_STEPS: u16 = 10;
+pub const DEFAULT_STEPS: u16 = 5;
 
 /// Gradient steps per denoising step of the shipped configuration.
-pub const DEFAULT_GRADIENT_STEPS: u8 = 4;
+pub const DEFAULT_GRADIENT_STEPS: u8 = 8;
+
+/// Per-joint limit of one gradient step in the shipped configuration, radians.
+pub const DEFAULT_STEP_LIMIT: f32 = 0.1;
+
+/// Refinement gradient steps after the last denoising step in the shipped configuration.
+pub const DEFAULT_REFINE_STEPS: u8 = 16;
 
 impl PlanConfig {
     /// The shipped configuration, picked from the suite measurements in the README: the
@@ -99,6 +117,8 @@ impl PlanConfig {
         guidance: GuidanceSchedule::Every {
             per_step: DEFAULT_GRADIENT_STEPS,
         },
+        refine: DEFAULT_REFINE_STEPS,
+        step_limit: DEFAULT_STEP_LIMIT,
         cylinder: CylinderBox::Enclosing,
         check: CheckConfig::DEFAULT,
     };
@@ -107,7 +127,7 @@ impl PlanConfig {
 impl<const B: usize> Plan<B> {
     /// Whether the chosen candidate passed the exact checker.
     pub fn is_free(&self) -> bool {
-        self.verdicts[self.best].colliding_states == 0
+        self.verdicts[self.best].free
     }
 
     /// FNV-1a (64 bit) over the bits of every candidate, every verdict and the chosen index:
@@ -126,6 +146,7 @@ impl<const B: usize> Plan<B> {
         }
         for verdict in &self.verdicts {
             eat(verdict.swept.to_bits());
+            eat(u32::from(verdict.free));
             eat(verdict.colliding_states);
         }
         eat(self.best as u32);
@@ -212,14 +233,37 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
             config.sampler.update(step, x, e, rng, start, goal);
         }
         for _ in 0..config.guidance.steps_at(step.t) {
-            guide_step(scene, paths, &mut work.grads, guides, step.t, config.cylinder)?;
+            guide_step(
+                scene,
+                paths,
+                &mut work.grads,
+                guides,
+                step.t,
+                config.step_limit,
+                config.cylinder,
+            )?;
         }
+    }
+    for _ in 0..config.refine {
+        guide_step(
+            scene,
+            paths,
+            &mut work.grads,
+            guides,
+            1,
+            config.step_limit,
+            config.cylinder,
+        )?;
     }
     Ok(())
 }
 
 /// Clamps every candidate into the soft limits (ends exact), judges it with the exact checker
 /// and the uninflated swept volume, and picks the winner.
+///
+/// The check of a colliding candidate stops at its first contact; only when no candidate is
+/// free are the colliding states counted in full, to rank the fallback. A free candidate is
+/// checked state by state to the end either way.
 pub fn select<const B: usize, const N: usize>(
     scene: &Scene<N>,
     start: &Joints<f32>,
@@ -237,6 +281,7 @@ pub fn select<const B: usize, const N: usize>(
     };
     let mut verdicts = [Verdict {
         swept: 0.0,
+        free: false,
         colliding_states: 0,
     }; B];
     for (x, verdict) in paths.iter_mut().zip(verdicts.iter_mut()) {
@@ -247,11 +292,17 @@ pub fn select<const B: usize, const N: usize>(
         }
         x[0] = *start;
         x[HORIZON - 1] = *goal;
-        let report = check_trajectory(scene, x, &config.check, false)?;
+        let report = check_trajectory(scene, x, &config.check, true)?;
         *verdict = Verdict {
             swept: trajectory_cost(scene, x, &swept, None)?,
+            free: report.is_free(),
             colliding_states: report.colliding_states,
         };
+    }
+    if !verdicts.iter().any(|v| v.free) {
+        for (x, verdict) in paths.iter().zip(verdicts.iter_mut()) {
+            verdict.colliding_states = check_trajectory(scene, x, &config.check, false)?.colliding_states;
+        }
     }
     let best = (0..B)
         .min_by(|&a, &b| {
@@ -288,6 +339,8 @@ mod tests {
         PlanConfig {
             sampler: Sampler::Strided { steps: 10 },
             guidance: GuidanceSchedule::Every { per_step: 4 },
+            refine: 0,
+            step_limit: f32::INFINITY,
             cylinder: CylinderBox::Enclosing,
             check: CheckConfig::default(),
         }

@@ -10,7 +10,8 @@ use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{CylinderBox, Inflation};
 use edmp_core::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{
-    DEFAULT_GRADIENT_STEPS, DEFAULT_STEPS, GuidanceSchedule, Plan, PlanConfig, Workspace, denoise, select,
+    DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
+    PlanConfig, Workspace, denoise, select,
 };
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
@@ -51,6 +52,13 @@ pub(crate) struct Tuning {
     /// Gradient steps of every guide after each denoising step (strided sampler).
     #[arg(long, default_value_t = DEFAULT_GRADIENT_STEPS)]
     gradient_steps: u8,
+    /// Refinement gradient steps of every guide after the last denoising step (at t = 1).
+    #[arg(long, default_value_t = DEFAULT_REFINE_STEPS)]
+    refine_steps: u8,
+    /// Largest move of one joint in one gradient step, radians (`inf`: the original's
+    /// unlimited step).
+    #[arg(long, default_value_t = DEFAULT_STEP_LIMIT)]
+    step_limit: f32,
     /// EDMP's original sampler and guidance: 255 ancestral steps, guidance on even t ≥ 6.
     #[arg(long)]
     ancestral: bool,
@@ -72,6 +80,8 @@ impl Tuning {
                     per_step: self.gradient_steps,
                 }
             },
+            refine: self.refine_steps,
+            step_limit: self.step_limit,
             cylinder: CylinderBox::Enclosing,
             check: CheckConfig::default(),
         };
@@ -91,8 +101,8 @@ impl Tuning {
             "ancestral K = 255, guidance on even t".to_owned()
         } else {
             format!(
-                "strided K = {}, {} gradient steps per step",
-                self.steps, self.gradient_steps
+                "strided K = {}, {} gradient steps per step, {} refinement steps",
+                self.steps, self.gradient_steps, self.refine_steps
             )
         }
     }
@@ -214,7 +224,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
             .map(|(row, (path, verdict))| {
                 json!({
                     "guide": guide_of(row),
-                    "collision_free": verdict.colliding_states == 0,
+                    "collision_free": verdict.free,
                     "swept_volume": verdict.swept,
                     "waypoints": path.iter().map(|q| q.to_vec()).collect::<Vec<_>>(),
                 })

@@ -59,6 +59,8 @@ fuzz_target!(|data: &[u8]| {
             Sampler::Ddim { steps }
         },
         guidance: GuidanceSchedule::Every { per_step: r.byte() % 3 },
+        refine: r.byte() % 3,
+        step_limit: f32::INFINITY,
         cylinder: CylinderBox::Enclosing,
         check: CheckConfig::default(),
     };
