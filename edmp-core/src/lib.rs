@@ -33,5 +33,7 @@ pub mod prior;
 pub mod rng;
 pub mod robot;
 pub mod scene;
+#[cfg(feature = "serde")]
+pub mod wire;
 
 pub use error::Error;

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 mod bench_plan;
 mod bench_rrt;
+mod embed;
 mod fk;
 mod gen_data;
 mod json;
@@ -45,6 +46,8 @@ enum Command {
     Render(render::Args),
     /// Measure the unguided diffusion prior: roughness, joint limits, self-collision, time.
     Sample(sample::Args),
+    /// Scenes as postcard bytes for the QEMU firmware, with the host's plan of each.
+    Embed(embed::Args),
 }
 
 /// What went wrong, and the exit status it maps to (`spec/formats.md`).
@@ -67,6 +70,7 @@ fn main() -> ExitCode {
         Command::GenData(args) => gen_data::run(&args).map_err(Failure::Input),
         Command::Render(args) => render::run(&args).map_err(Failure::Input),
         Command::Sample(args) => sample::run(&args).map_err(Failure::Input),
+        Command::Embed(args) => embed::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

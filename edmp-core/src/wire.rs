@@ -1,0 +1,166 @@
+//! A planning problem as plain numbers, for the wire (postcard) into firmware.
+//!
+//! [`Scene`] holds validated obstacles (rotation matrices); the wire carries what a scene file
+//! says instead: each primitive's parameters and quaternion, the start, a joint goal (a pose
+//! goal is resolved on the host: the firmware runs no IK) and the seed. [`Problem::to_scene`]
+//! rebuilds the scene through the same [`Obstacle`] constructors the host uses, so both sides
+//! plan on the same bits. Only with the `serde` feature.
+
+use crate::kinematics::Joints;
+use crate::scene::{MAX_OBSTACLES, Obstacle, Scene, SceneError};
+use serde::{Deserialize, Serialize};
+
+/// An obstacle as its parameters (quaternions `[w, x, y, z]`, as in `edmp-scene/1`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Primitive {
+    /// A box with full extents `dims`.
+    Cuboid {
+        /// Centre.
+        center: [f32; 3],
+        /// Full extents along the box's x, y, z.
+        dims: [f32; 3],
+        /// Orientation.
+        quaternion: [f32; 4],
+    },
+    /// A cylinder along its local z.
+    Cylinder {
+        /// Centre.
+        center: [f32; 3],
+        /// Radius.
+        radius: f32,
+        /// Full length along z.
+        height: f32,
+        /// Orientation.
+        quaternion: [f32; 4],
+    },
+    /// A ball.
+    Sphere {
+        /// Centre.
+        center: [f32; 3],
+        /// Radius.
+        radius: f32,
+    },
+}
+
+impl Primitive {
+    /// The validated obstacle ([`Obstacle::cuboid`], [`Obstacle::cylinder`], [`Obstacle::sphere`]).
+    pub fn to_obstacle(&self) -> Result<Obstacle, SceneError> {
+        match *self {
+            Self::Cuboid {
+                center,
+                dims,
+                quaternion,
+            } => Obstacle::cuboid(center, dims, quaternion),
+            Self::Cylinder {
+                center,
+                radius,
+                height,
+                quaternion,
+            } => Obstacle::cylinder(center, radius, height, quaternion),
+            Self::Sphere { center, radius } => Obstacle::sphere(center, radius),
+        }
+    }
+}
+
+/// One planning problem: obstacles (at most `N`), the held object, the ends and the seed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Problem<const N: usize = MAX_OBSTACLES> {
+    /// The obstacles, in the scene file's order (the checker reports contacts by index).
+    pub obstacles: heapless::Vec<Primitive, N>,
+    /// An object held in the hand (pose in the `panda_hand` frame), if any.
+    pub held: Option<Primitive>,
+    /// Start configuration.
+    pub start: Joints<f32>,
+    /// Goal configuration.
+    pub goal: Joints<f32>,
+    /// Seed of the planner's [`crate::rng::Rng`].
+    pub seed: u64,
+}
+
+impl<const N: usize> Problem<N> {
+    /// The scene, every primitive validated on the way in.
+    pub fn to_scene(&self) -> Result<Scene<N>, SceneError> {
+        let mut scene = Scene::new();
+        for primitive in &self.obstacles {
+            scene.push(primitive.to_obstacle()?)?;
+        }
+        if let Some(held) = &self.held {
+            scene.hold(held.to_obstacle()?);
+        }
+        Ok(scene)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
+
+    fn problem() -> Problem<4> {
+        let mut obstacles = heapless::Vec::new();
+        for p in [
+            Primitive::Cuboid {
+                center: [0.5, 0.0, -0.01],
+                dims: [1.2, 1.6, 0.02],
+                quaternion: ID,
+            },
+            Primitive::Cylinder {
+                center: [0.45, 0.45, 0.1],
+                radius: 0.05,
+                height: 0.2,
+                quaternion: ID,
+            },
+            Primitive::Sphere {
+                center: [0.35, -0.45, 0.6],
+                radius: 0.06,
+            },
+        ] {
+            obstacles.push(p).unwrap();
+        }
+        Problem {
+            obstacles,
+            held: None,
+            start: [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785],
+            goal: [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785],
+            seed: 7,
+        }
+    }
+
+    #[test]
+    fn builds_the_scene_through_the_constructors() {
+        let p = problem();
+        let scene = p.to_scene().unwrap();
+        assert_eq!(scene.obstacles().len(), 3);
+        assert_eq!(
+            scene.obstacles()[1],
+            Obstacle::cylinder([0.45, 0.45, 0.1], 0.05, 0.2, ID).unwrap()
+        );
+        assert!(scene.held().is_none());
+    }
+
+    #[test]
+    fn bad_primitives_are_typed_errors() {
+        let mut p = problem();
+        p.held = Some(Primitive::Sphere {
+            center: [0.0; 3],
+            radius: -1.0,
+        });
+        assert_eq!(p.to_scene().unwrap_err(), SceneError::NonPositiveSize);
+        p.held = None;
+        p.obstacles[0] = Primitive::Cuboid {
+            center: [0.0; 3],
+            dims: [1.0; 3],
+            quaternion: [0.5, 0.0, 0.0, 0.0],
+        };
+        assert_eq!(p.to_scene().unwrap_err(), SceneError::QuaternionNorm);
+    }
+
+    #[test]
+    fn carries_the_held_object() {
+        let mut p = problem();
+        p.held = Some(p.obstacles[2]);
+        let scene = p.to_scene().unwrap();
+        assert_eq!(scene.held(), Some(&scene.obstacles()[2]));
+    }
+}

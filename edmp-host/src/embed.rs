@@ -1,0 +1,184 @@
+//! `edmp-host embed`: scene files as postcard bytes for the firmware (`edmp_core::wire`), and the
+//! host's own plan of each, so that `scripts/firmware` can compare the two bit for bit.
+//!
+//! Writes `DIR/<name>.postcard` per scene (`<name>`: the file's folder and stem, e.g.
+//! `tabletop-000`) and `DIR/expected.txt`, one line `<name> <status> <fingerprint>` per scene in
+//! the order given. The host plans the scene it rebuilt from the wire bytes, with the firmware's
+//! settings: [`PlanConfig::DEFAULT`], EDMP's 12 guides, 12 rows, `Rng::new(seed)`.
+
+use crate::Failure;
+use crate::json::{joint_goal, parse_problem};
+use core::fmt::Write as _;
+use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::planner::{Plan, PlanConfig, Workspace, plan};
+use edmp_core::prior::Scratch;
+use edmp_core::rng::Rng;
+use edmp_core::scene::{MAX_OBSTACLES, Scene};
+use edmp_core::wire::{Primitive, Problem};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// Rows of the firmware's batch: one per EDMP guide.
+pub(crate) const ROWS: usize = 12;
+
+/// Arguments of `edmp-host embed`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct Args {
+    /// Scene files (`edmp-scene/1` JSON).
+    #[arg(required = true)]
+    scenes: Vec<PathBuf>,
+    /// Folder for the `.postcard` files and `expected.txt`.
+    #[arg(long)]
+    out: PathBuf,
+    /// Seed of every plan (stored in each problem's bytes).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+/// `tabletop-000` for `benchmarks/problems/tabletop/000.json`, `examples-wall` for `examples/wall.json`.
+fn scene_name(path: &Path) -> Result<String, String> {
+    let stem = path.file_stem().and_then(|s| s.to_str());
+    let folder = path
+        .canonicalize()
+        .ok()
+        .and_then(|p| p.parent()?.file_name()?.to_str().map(str::to_owned));
+    match (folder, stem) {
+        (Some(folder), Some(stem)) => Ok(format!("{folder}-{stem}")),
+        _ => Err(format!("{}: cannot name this scene", path.display())),
+    }
+}
+
+/// The same conversion as `json::parse_problem`: f64 → f32, rounding to nearest.
+fn f32_at(v: &Value, path: &str) -> Result<f32, String> {
+    v.as_f64()
+        .map(|x| x as f32)
+        .ok_or_else(|| format!("{path}: expected a number"))
+}
+
+fn f32s<const K: usize>(v: &Value, path: &str) -> Result<[f32; K], String> {
+    let items = v.as_array().filter(|a| a.len() == K);
+    let items = items.ok_or_else(|| format!("{path}: expected {K} numbers"))?;
+    let mut out = [0.0f32; K];
+    for (slot, item) in out.iter_mut().zip(items) {
+        *slot = f32_at(item, path)?;
+    }
+    Ok(out)
+}
+
+/// A primitive's parameters as the file has them (already validated by `parse_problem`).
+fn primitive(v: &Value, path: &str) -> Result<Primitive, String> {
+    let center = f32s::<3>(&v["center"], &format!("{path}.center"))?;
+    match v["type"].as_str() {
+        Some("cuboid") => Ok(Primitive::Cuboid {
+            center,
+            dims: f32s::<3>(&v["dims"], &format!("{path}.dims"))?,
+            quaternion: f32s::<4>(&v["quaternion"], &format!("{path}.quaternion"))?,
+        }),
+        Some("cylinder") => Ok(Primitive::Cylinder {
+            center,
+            radius: f32_at(&v["radius"], &format!("{path}.radius"))?,
+            height: f32_at(&v["height"], &format!("{path}.height"))?,
+            quaternion: f32s::<4>(&v["quaternion"], &format!("{path}.quaternion"))?,
+        }),
+        Some("sphere") => Ok(Primitive::Sphere {
+            center,
+            radius: f32_at(&v["radius"], &format!("{path}.radius"))?,
+        }),
+        _ => Err(format!("{path}.type: expected cuboid, cylinder or sphere")),
+    }
+}
+
+/// The wire problem of a scene file: validated by `parse_problem`, goal resolved to joints.
+pub(crate) fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, String> {
+    let parsed = parse_problem(text).map_err(|e| e.to_string())?;
+    let goal = joint_goal(&parsed)?;
+    let root: Value = serde_json::from_str(text).map_err(|e| e.to_string())?;
+    let mut problem = Problem {
+        obstacles: Default::default(),
+        held: None,
+        start: parsed.start,
+        goal,
+        seed,
+    };
+    for (i, o) in root["obstacles"].as_array().into_iter().flatten().enumerate() {
+        problem
+            .obstacles
+            .push(primitive(o, &format!("obstacles[{i}]"))?)
+            .map_err(|_| format!("more than {MAX_OBSTACLES} obstacles"))?;
+    }
+    if let Some(h) = root.get("held_object") {
+        problem.held = Some(primitive(h, "held_object")?);
+    }
+    // The firmware rebuilds the scene from these numbers: it must be the host's scene exactly.
+    let rebuilt = problem.to_scene().map_err(|e| e.to_string())?;
+    if rebuilt.obstacles() != parsed.scene.obstacles() || rebuilt.held() != parsed.scene.held() {
+        return Err("the wire scene differs from the parsed one".to_owned());
+    }
+    Ok(problem)
+}
+
+/// The firmware's plan, on the host: same configuration, guides, rows and seed.
+pub(crate) fn plan_like_firmware(problem: &Problem<MAX_OBSTACLES>) -> Result<Plan<ROWS>, String> {
+    let scene: Scene<MAX_OBSTACLES> = problem.to_scene().map_err(|e| e.to_string())?;
+    let mut scratch = Box::new(Scratch::<4>::new());
+    let mut work = Box::new(Workspace::<ROWS>::new());
+    let mut rng = Rng::new(problem.seed);
+    plan::<ROWS, MAX_OBSTACLES, 4>(
+        &scene,
+        &problem.start,
+        &problem.goal,
+        &EDMP_GUIDES,
+        &PlanConfig::DEFAULT,
+        &mut rng,
+        &mut scratch,
+        &mut work,
+    )
+    .map_err(|e| format!("planner: {e}"))
+}
+
+/// Writes the bytes and the expected results.
+pub(crate) fn run(args: &Args) -> Result<(), Failure> {
+    let input = |e: String| Failure::Input(e);
+    std::fs::create_dir_all(&args.out).map_err(|e| input(format!("{}: {e}", args.out.display())))?;
+    let mut expected = String::new();
+    for path in &args.scenes {
+        let at = |e: String| Failure::Input(format!("{}: {e}", path.display()));
+        let name = scene_name(path).map_err(input)?;
+        let text = std::fs::read_to_string(path).map_err(|e| at(e.to_string()))?;
+        let problem = wire_problem(&text, args.seed).map_err(at)?;
+        let bytes = postcard::to_stdvec(&problem).map_err(|e| at(e.to_string()))?;
+        let file = args.out.join(format!("{name}.postcard"));
+        std::fs::write(&file, &bytes).map_err(|e| input(format!("{}: {e}", file.display())))?;
+        let plan = plan_like_firmware(&problem).map_err(at)?;
+        let status = if plan.is_free() { "success" } else { "collision" };
+        let line = format!("{name} {status} {:016x}", plan.fingerprint());
+        println!("{line}  ({} bytes)", bytes.len());
+        let _ = writeln!(expected, "{line}");
+    }
+    let file = args.out.join("expected.txt");
+    std::fs::write(&file, expected).map_err(|e| input(format!("{}: {e}", file.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wall_round_trips_through_postcard() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/wall.json")).unwrap();
+        let problem = wire_problem(&text, 3).unwrap();
+        assert_eq!(problem.obstacles.len(), 4);
+        let bytes = postcard::to_stdvec(&problem).unwrap();
+        let back: Problem<MAX_OBSTACLES> = postcard::from_bytes(&bytes).unwrap();
+        assert_eq!(back, problem);
+        assert_eq!(back.seed, 3);
+    }
+
+    #[test]
+    fn names_scenes_by_folder_and_stem() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let suite = root.join("benchmarks/problems/tabletop/000.json");
+        assert_eq!(scene_name(&suite).unwrap(), "tabletop-000");
+        assert_eq!(scene_name(&root.join("examples/wall.json")).unwrap(), "examples-wall");
+    }
+}
