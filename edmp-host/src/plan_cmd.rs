@@ -5,9 +5,8 @@
 
 use crate::Failure;
 use crate::json::{Problem, joint_goal, parse_problem};
-use edmp_core::checker::CheckConfig;
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
-use edmp_core::geometry::{CylinderBox, Inflation};
+use edmp_core::geometry::Inflation;
 use edmp_core::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
@@ -82,9 +81,14 @@ impl Tuning {
             },
             refine: self.refine_steps,
             step_limit: self.step_limit,
-            cylinder: CylinderBox::Enclosing,
-            check: CheckConfig::default(),
+            ..PlanConfig::DEFAULT
         };
+        if self.step_limit.is_nan() || self.step_limit <= 0.0 {
+            return Err(Failure::Input(format!(
+                "--step-limit: {} is not a positive number of radians",
+                self.step_limit
+            )));
+        }
         config.sampler.validate().map_err(|_| {
             Failure::Input(format!(
                 "--steps: {} outside 1..={}",
@@ -243,5 +247,25 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
             "no collision-free candidate; wrote the least colliding one ({} colliding states)",
             plan.verdicts[plan.best].colliding_states
         )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, clap::Parser)]
+    struct Cli {
+        #[command(flatten)]
+        tuning: Tuning,
+    }
+
+    #[test]
+    fn the_flags_default_to_the_cores_shipped_configuration() {
+        let cli = Cli::parse_from(["edmp-host"]);
+        assert!(cli.tuning.config().is_ok_and(|c| c == PlanConfig::DEFAULT));
+        let cli = Cli::parse_from(["edmp-host", "--step-limit", "0"]);
+        assert!(cli.tuning.config().is_err());
     }
 }

@@ -210,3 +210,133 @@ fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The scene of an `edmp-scene/1` document, rebuilt here from the JSON with the core's
+/// constructors (independent of the host's parser).
+fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene {
+    use edmp_core::scene::{Obstacle, Scene};
+    let v3 = |v: &serde_json::Value| -> [f32; 3] { std::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
+    let v4 = |v: &serde_json::Value| -> [f32; 4] { std::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
+    let primitive = |o: &serde_json::Value| -> Obstacle {
+        let c = v3(&o["center"]);
+        match o["type"].as_str().unwrap() {
+            "cuboid" => Obstacle::cuboid(c, v3(&o["dims"]), v4(&o["quaternion"])).unwrap(),
+            "cylinder" => Obstacle::cylinder(
+                c,
+                o["radius"].as_f64().unwrap() as f32,
+                o["height"].as_f64().unwrap() as f32,
+                v4(&o["quaternion"]),
+            )
+            .unwrap(),
+            "sphere" => Obstacle::sphere(c, o["radius"].as_f64().unwrap() as f32).unwrap(),
+            other => panic!("unknown type {other}"),
+        }
+    };
+    let mut scene = Scene::new();
+    for o in doc["obstacles"].as_array().unwrap() {
+        scene.push(primitive(o)).unwrap();
+    }
+    if let Some(held) = doc.get("held_object") {
+        scene.hold(primitive(held));
+    }
+    scene
+}
+
+fn joints(v: &serde_json::Value) -> [f32; 7] {
+    std::array::from_fn(|i| v[i].as_f64().unwrap() as f32)
+}
+
+#[test]
+fn every_example_plans_a_collision_free_path_from_its_start_to_its_goal() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples");
+    let mut examples: Vec<_> = std::fs::read_dir(root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    examples.sort();
+    assert!(examples.len() >= 4, "{examples:?}");
+    let mut pose_goals = 0;
+    for path in examples {
+        let name = path.display().to_string();
+        let out = edmp_host(&["plan", path.to_str().unwrap()]);
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let plan: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        assert_eq!(plan["status"], "success", "{name}");
+        let waypoints: Vec<[f32; 7]> = plan["waypoints"].as_array().unwrap().iter().map(joints).collect();
+        assert_eq!(waypoints.len(), 50, "{name}");
+        assert_eq!(waypoints[0], joints(&doc["start"]), "{name}: start");
+        let last = waypoints[49];
+        if let Some(goal) = doc["goal"].get("joints") {
+            assert_eq!(last, joints(goal), "{name}: goal");
+        } else {
+            pose_goals += 1;
+            let pose = &doc["goal"]["pose"];
+            let tcp = *edmp_core::kinematics::forward::<f32>(&last).unwrap().tcp();
+            let p = &pose["position"];
+            let error: f32 = (0..3)
+                .map(|i| (tcp.translation[i] - p[i].as_f64().unwrap() as f32).powi(2))
+                .sum::<f32>()
+                .sqrt();
+            assert!(error < 1e-3, "{name}: TCP {error} m from the goal");
+            let q = pose["quaternion"].as_array().unwrap();
+            let want = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                q[0].as_f64().unwrap() as f32,
+                q[1].as_f64().unwrap() as f32,
+                q[2].as_f64().unwrap() as f32,
+                q[3].as_f64().unwrap() as f32,
+            ));
+            let got = nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(
+                tcp.rotation,
+            ));
+            assert!(
+                got.angle_to(&want) < 1e-2,
+                "{name}: TCP {} rad off",
+                got.angle_to(&want)
+            );
+        }
+        assert!(
+            waypoints
+                .iter()
+                .all(|q| edmp_core::robot::PANDA.within_soft_limits(q, 0.0)),
+            "{name}: outside the limits"
+        );
+        let trajectory: [[f32; 7]; 50] = std::array::from_fn(|i| waypoints[i]);
+        let report = edmp_core::checker::check_trajectory(
+            &scene_of(&doc),
+            &trajectory,
+            &edmp_core::checker::CheckConfig::DEFAULT,
+            false,
+        )
+        .unwrap();
+        assert!(report.is_free(), "{name}: {report:?}");
+    }
+    assert!(pose_goals >= 1, "one example has a pose goal");
+}
+
+#[test]
+fn plan_exits_1_and_still_writes_the_least_colliding_plan_when_no_candidate_is_free() {
+    // Two unguided denoising steps: the prior's paths run through the wall.
+    let dir = std::env::temp_dir().join(format!("edmp-plan-1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("plan.json");
+    let out = edmp_host(&[
+        "plan",
+        "examples/wall.json",
+        "--steps",
+        "2",
+        "--gradient-steps",
+        "0",
+        "--refine-steps",
+        "0",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no collision-free candidate"));
+    let plan: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert_eq!(plan["status"], "collision");
+    assert_eq!(plan["waypoints"].as_array().unwrap().len(), 50);
+    std::fs::remove_dir_all(&dir).ok();
+}
