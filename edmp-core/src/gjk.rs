@@ -15,6 +15,15 @@ pub const MAX_ITERATIONS: usize = 48;
 
 type V = Vector3<f32>;
 
+/// Up to four vertices of the Minkowski difference; only the first `n` are in use.
+type Simplex = [V; 4];
+
+/// Vertex `i` (always below 4; the mask lets the compiler drop the bounds check, so no panic
+/// path is linked).
+fn vertex(s: &Simplex, i: u8) -> V {
+    s[usize::from(i & 3)]
+}
+
 fn support<A: Convex, B: Convex>(a: &A, b: &B, d: &V) -> V {
     a.support(d) - b.support(&-d)
 }
@@ -40,18 +49,19 @@ pub fn closest<A: Convex, B: Convex>(a: &A, b: &B, start: &V) -> Option<V> {
         }
         let w = support(a, b, &-v);
         // Converged: the new support point brings no real progress towards the origin.
-        if vv - v.dot(&w) <= 1e-6 * vv || simplex[..n].contains(&w) {
+        if vv - v.dot(&w) <= 1e-6 * vv || simplex.iter().take(n).any(|p| *p == w) {
             return Some(v);
         }
-        simplex[n] = w;
+        // `n` ≤ 3 here (a kept tetrahedron returned above); a full simplex would mean overlap.
+        *simplex.get_mut(n)? = w;
         n += 1;
-        let (point, kept) = nearest_on_simplex(&simplex[..n]);
+        let (point, kept) = nearest_on_simplex(&simplex, n);
         if kept.len == 4 {
             return None;
         }
         let mut next = [V::zeros(); 4];
-        for (slot, &i) in next.iter_mut().zip(kept.index[..kept.len].iter()) {
-            *slot = simplex[usize::from(i)];
+        for (slot, &i) in next.iter_mut().zip(kept.index.iter().take(kept.len)) {
+            *slot = vertex(&simplex, i);
         }
         simplex = next;
         n = kept.len;
@@ -116,17 +126,20 @@ struct Kept {
 impl Kept {
     fn of(indices: &[u8]) -> Self {
         let mut index = [0; 4];
-        index[..indices.len()].copy_from_slice(indices);
+        for (slot, &i) in index.iter_mut().zip(indices) {
+            *slot = i;
+        }
         Self {
             index,
-            len: indices.len(),
+            len: indices.len().min(4),
         }
     }
 }
 
-/// Point of the simplex (1-4 vertices) nearest the origin, and the vertices of the face it lies on.
-fn nearest_on_simplex(s: &[V]) -> (V, Kept) {
-    match s.len() {
+/// Point of the simplex's first `n` (1-4) vertices nearest the origin, and the vertices of the
+/// face it lies on.
+fn nearest_on_simplex(s: &Simplex, n: usize) -> (V, Kept) {
+    match n {
         1 => (s[0], Kept::of(&[0])),
         2 => nearest_on_segment(s, [0, 1]),
         3 => nearest_on_triangle(s, [0, 1, 2]),
@@ -134,8 +147,8 @@ fn nearest_on_simplex(s: &[V]) -> (V, Kept) {
     }
 }
 
-fn nearest_on_segment(s: &[V], [i, j]: [u8; 2]) -> (V, Kept) {
-    let (a, b) = (s[usize::from(i)], s[usize::from(j)]);
+fn nearest_on_segment(s: &Simplex, [i, j]: [u8; 2]) -> (V, Kept) {
+    let (a, b) = (vertex(s, i), vertex(s, j));
     let ab = b - a;
     let len2 = ab.norm_squared();
     if len2 <= 0.0 {
@@ -152,8 +165,8 @@ fn nearest_on_segment(s: &[V], [i, j]: [u8; 2]) -> (V, Kept) {
 }
 
 /// Ericson, *Real-Time Collision Detection* §5.1.5, with the query point at the origin.
-fn nearest_on_triangle(s: &[V], [i, j, k]: [u8; 3]) -> (V, Kept) {
-    let (a, b, c) = (s[usize::from(i)], s[usize::from(j)], s[usize::from(k)]);
+fn nearest_on_triangle(s: &Simplex, [i, j, k]: [u8; 3]) -> (V, Kept) {
+    let (a, b, c) = (vertex(s, i), vertex(s, j), vertex(s, k));
     let (ab, ac, ap) = (b - a, c - a, -a);
     let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
     if d1 <= 0.0 && d2 <= 0.0 {
@@ -207,17 +220,12 @@ fn best_of<const M: usize>(candidates: [(V, Kept); M]) -> (V, Kept) {
     best
 }
 
-fn nearest_on_tetrahedron(s: &[V]) -> (V, Kept) {
+fn nearest_on_tetrahedron(s: &Simplex) -> (V, Kept) {
     let faces: [[u8; 4]; 4] = [[0, 1, 2, 3], [0, 1, 3, 2], [0, 2, 3, 1], [1, 2, 3, 0]];
     let mut best: Option<(V, Kept)> = None;
     let mut inside = true;
     for [i, j, k, opposite] in faces {
-        let (a, b, c, d) = (
-            s[usize::from(i)],
-            s[usize::from(j)],
-            s[usize::from(k)],
-            s[usize::from(opposite)],
-        );
+        let (a, b, c, d) = (vertex(s, i), vertex(s, j), vertex(s, k), vertex(s, opposite));
         let normal = (b - a).cross(&(c - a));
         let origin_side = (-a).dot(&normal);
         let other_side = (d - a).dot(&normal);

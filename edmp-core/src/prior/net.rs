@@ -391,13 +391,21 @@ fn mish_from_exp(x: f32, u: f32) -> f32 {
 }
 
 fn linear(layer: &Linear, input: &[f32], out: &mut [f32]) {
-    for (o, y) in out.iter_mut().enumerate().take(layer.fout) {
-        let row = &layer.weights[o * layer.fin..(o + 1) * layer.fin];
+    // Iterators and `get`, not indexing, here and below: the generated tables always fit, and
+    // this way no bounds-check panic path is linked into firmware.
+    let rows = layer.weights.chunks_exact(layer.fin.max(1));
+    for (((y, row), scale), bias) in out
+        .iter_mut()
+        .zip(rows)
+        .zip(layer.scale)
+        .zip(layer.bias)
+        .take(layer.fout)
+    {
         let acc = row
             .iter()
             .zip(input)
             .fold(0.0f32, |acc, (w, x)| acc + f32::from(*w as i8) * x);
-        *y = acc * layer.scale[o] + layer.bias[o];
+        *y = acc * scale + bias;
     }
 }
 
@@ -494,17 +502,26 @@ fn conv_rows<const CO: usize, const K: usize>(
     for c in 0..CO {
         let w = conv.weights.get((co0 + c) * taps..(co0 + c + 1) * taps).unwrap_or(&[]);
         for (t, w) in w.iter().enumerate() {
-            wbuf[t * CO + c] = f32::from(*w as i8);
+            if let Some(slot) = wbuf.get_mut(t * CO + c) {
+                *slot = f32::from(*w as i8);
+            }
         }
     }
-    if mode == Accumulate::Overwrite {
-        out[co0 * row..(co0 + CO) * row].fill(0.0);
+    if mode == Accumulate::Overwrite
+        && let Some(rows) = out.get_mut(co0 * row..(co0 + CO) * row)
+    {
+        rows.fill(0.0);
     }
+    // `taps · CO` ≤ `MAX_TAPS · TILE_CHANNELS` for every generated layer; the exact length lets
+    // the compiler drop the tile's checks.
+    let Some(weights) = wbuf.get(..taps * CO) else {
+        return;
+    };
     // Output q sits at row index q + PAD and reads input q + shift .. q + shift + K.
     let outputs = lay.batch * seg - 2 * PAD;
     let mut q0 = 0;
     while q0 < outputs {
-        let acc = conv_tile::<CO, K>(&wbuf[..taps * CO], &input[shift + q0..], row, conv.cin);
+        let acc = conv_tile::<CO, K>(weights, input.get(shift + q0..).unwrap_or(&[]), row, conv.cin);
         // Keep the tile's data positions: trajectory b's run [b·seg + PAD, b·seg + PAD + len).
         let (lo, hi) = (q0 + PAD, (q0 + PAD + TILE).min(outputs + PAD));
         let mut b = lo / seg;
@@ -512,9 +529,13 @@ fn conv_rows<const CO: usize, const K: usize>(
             let (from, to) = ((b * seg + PAD).max(lo), (b * seg + PAD + lay.len).min(hi));
             if from < to {
                 for (c, acc_c) in acc.iter().enumerate() {
-                    let (scale, bias) = (conv.scale[co0 + c], conv.bias[co0 + c]);
-                    let dst = &mut out[(co0 + c) * row + from..(co0 + c) * row + to];
-                    for (d, a) in dst.iter_mut().zip(&acc_c[from - lo..]) {
+                    let (Some(&scale), Some(&bias)) = (conv.scale.get(co0 + c), conv.bias.get(co0 + c)) else {
+                        continue;
+                    };
+                    let Some(dst) = out.get_mut((co0 + c) * row + from..(co0 + c) * row + to) else {
+                        continue;
+                    };
+                    for (d, a) in dst.iter_mut().zip(acc_c.get(from - lo..).unwrap_or(&[])) {
                         match mode {
                             Accumulate::Overwrite => *d = *a * scale + bias,
                             Accumulate::Add => *d += *a * scale + bias,
@@ -531,24 +552,33 @@ fn conv_rows<const CO: usize, const K: usize>(
 /// Stride-2 convolution, k 3, pad 1, per trajectory: `len` → ⌈len / 2⌉.
 fn conv_down(conv: &Conv, input: &[f32], lay: Layout, out: &mut [f32], lay_out: Layout) {
     let mut acc = [0.0f32; LENGTHS[0]];
-    let acc = &mut acc[..lay_out.len];
-    out[..conv.cout * lay_out.row()].fill(0.0);
-    for co in 0..conv.cout {
+    let acc = &mut acc[..lay_out.len.min(LENGTHS[0])];
+    if let Some(rows) = out.get_mut(..conv.cout * lay_out.row()) {
+        rows.fill(0.0);
+    }
+    for ((co, &scale), &bias) in (0..conv.cout).zip(conv.scale).zip(conv.bias) {
         for b in 0..lay.batch {
             acc.fill(0.0);
             for ci in 0..conv.cin {
-                let taps = &conv.weights[(co * conv.cin + ci) * conv.k..(co * conv.cin + ci + 1) * conv.k];
+                let first = (co * conv.cin + ci) * conv.k;
+                let Some(taps) = conv.weights.get(first..first + conv.k) else {
+                    continue;
+                };
                 for (kk, w) in taps.iter().enumerate() {
                     let w = f32::from(*w as i8);
                     // Output l reads input 2l + kk − 1.
-                    let x = input[lay.at(ci, b, 0) + kk - 1..].iter().step_by(2);
-                    for (a, v) in acc.iter_mut().zip(x) {
+                    let Some(x) = input.get(lay.at(ci, b, 0) + kk - 1..) else {
+                        continue;
+                    };
+                    for (a, v) in acc.iter_mut().zip(x.iter().step_by(2)) {
                         *a += w * v;
                     }
                 }
             }
             let start = lay_out.at(co, b, 0);
-            write_run(&mut out[start..start + lay_out.len], acc, conv.scale[co], conv.bias[co]);
+            if let Some(dst) = out.get_mut(start..start + lay_out.len) {
+                write_run(dst, acc, scale, bias);
+            }
         }
     }
 }
@@ -557,23 +587,32 @@ fn conv_down(conv: &Conv, input: &[f32], lay: Layout, out: &mut [f32], lay_out: 
 /// Input i lands on output 2i + k − 1, so output 2m takes taps 1 (x_m) and 3 (x_{m−1}) and
 /// output 2m + 1 takes taps 0 (x_{m+1}) and 2 (x_m); the zero pads supply x_{−1} and x_len.
 fn conv_up(conv: &Conv, input: &[f32], lay: Layout, out: &mut [f32], lay_out: Layout) {
-    let len = lay.len;
+    let len = lay.len.min(LENGTHS[0]);
+    let out_len = lay_out.len.min(LENGTHS[0]);
     let (mut even, mut odd) = ([0.0f32; LENGTHS[0]], [0.0f32; LENGTHS[0]]);
     let mut acc = [0.0f32; LENGTHS[0]];
-    out[..conv.cout * lay_out.row()].fill(0.0);
-    for co in 0..conv.cout {
+    if let Some(rows) = out.get_mut(..conv.cout * lay_out.row()) {
+        rows.fill(0.0);
+    }
+    for ((co, &scale), &bias) in (0..conv.cout).zip(conv.scale).zip(conv.bias) {
         for b in 0..lay.batch {
             even[..len].fill(0.0);
             odd[..len].fill(0.0);
             for ci in 0..conv.cin {
                 let at = lay.at(ci, b, 0);
-                let w = &conv.weights[(co * conv.cin + ci) * 4..(co * conv.cin + ci + 1) * 4];
-                let [w0, w1, w2, w3] = [0, 1, 2, 3].map(|k| f32::from(w[k] as i8));
-                let (prev, here, next) = (
-                    &input[at - 1..at - 1 + len],
-                    &input[at..at + len],
-                    &input[at + 1..at + 1 + len],
-                );
+                let w = conv
+                    .weights
+                    .get((co * conv.cin + ci) * 4..)
+                    .and_then(|w| w.first_chunk::<4>());
+                let Some(&w) = w else { continue };
+                let [w0, w1, w2, w3] = w.map(|w| f32::from(w as i8));
+                let (Some(prev), Some(here), Some(next)) = (
+                    input.get(at - 1..at - 1 + len),
+                    input.get(at..at + len),
+                    input.get(at + 1..at + 1 + len),
+                ) else {
+                    continue;
+                };
                 for (((e, o), (p, h)), n) in even[..len]
                     .iter_mut()
                     .zip(&mut odd[..len])
@@ -586,21 +625,16 @@ fn conv_up(conv: &Conv, input: &[f32], lay: Layout, out: &mut [f32], lay_out: La
                     *o += w2 * h;
                 }
             }
-            for (m, (e, o)) in even[..len].iter().zip(&odd[..len]).enumerate() {
-                if 2 * m < lay_out.len {
-                    acc[2 * m] = *e;
-                }
-                if 2 * m + 1 < lay_out.len {
-                    acc[2 * m + 1] = *o;
+            for (pair, (e, o)) in acc[..out_len].chunks_mut(2).zip(even[..len].iter().zip(&odd[..len])) {
+                // Output 2m is the even sum, 2m + 1 the odd one (dropped past the crop).
+                for (a, v) in pair.iter_mut().zip([e, o]) {
+                    *a = *v;
                 }
             }
             let start = lay_out.at(co, b, 0);
-            write_run(
-                &mut out[start..start + lay_out.len],
-                &acc[..lay_out.len],
-                conv.scale[co],
-                conv.bias[co],
-            );
+            if let Some(dst) = out.get_mut(start..start + lay_out.len) {
+                write_run(dst, &acc[..out_len], scale, bias);
+            }
         }
     }
 }
@@ -621,21 +655,25 @@ fn norm_mish(x: &mut [f32], channels: usize, lay: Layout, gamma: &[f32], beta: &
     for b in 0..lay.batch {
         for g in 0..GROUPS {
             let rows = g * per_group..(g + 1) * per_group;
+            let run = |c: usize| x.get(lay.at(c, b, 0)..lay.at(c, b, len)).unwrap_or(&[]);
             let mut sum = 0.0f32;
             for c in rows.clone() {
-                sum += x[lay.at(c, b, 0)..lay.at(c, b, len)].iter().fold(0.0f32, |a, v| a + v);
+                sum += run(c).iter().fold(0.0f32, |a, v| a + v);
             }
             let mean = sum / count;
             let mut var = 0.0f32;
             for c in rows.clone() {
-                var += x[lay.at(c, b, 0)..lay.at(c, b, len)]
-                    .iter()
-                    .fold(0.0f32, |a, v| a + (v - mean) * (v - mean));
+                var += run(c).iter().fold(0.0f32, |a, v| a + (v - mean) * (v - mean));
             }
             let inv = 1.0 / libm::sqrtf(var / count + 1e-5);
             for c in rows {
-                let (ga, be) = (gamma[c] * inv, beta[c]);
-                let run = &mut x[lay.at(c, b, 0)..lay.at(c, b, len)];
+                let (Some(&ga), Some(&be)) = (gamma.get(c), beta.get(c)) else {
+                    continue;
+                };
+                let ga = ga * inv;
+                let Some(run) = x.get_mut(lay.at(c, b, 0)..lay.at(c, b, len)) else {
+                    continue;
+                };
                 for (v, e) in run.iter_mut().zip(&mut u) {
                     *v = (*v - mean) * ga + be;
                     *e = libm::expf(v.min(20.0));
@@ -663,13 +701,13 @@ fn res_block(
     out: &mut [f32],
     wbuf: &mut WeightTile,
 ) {
-    let cout = block.block0.conv.cout;
+    let cout = block.block0.conv.cout.min(MAX_WIDTH);
     conv_block(&block.block0, x, lay, h, wbuf);
     let mut shift = [0.0f32; MAX_WIDTH];
     linear(&block.time, temb, &mut shift[..cout]);
     for (c, add) in shift[..cout].iter().enumerate() {
         for b in 0..lay.batch {
-            for v in &mut h[lay.at(c, b, 0)..lay.at(c, b, lay.len)] {
+            for v in h.get_mut(lay.at(c, b, 0)..lay.at(c, b, lay.len)).unwrap_or(&mut []) {
                 *v += add;
             }
         }
@@ -679,7 +717,7 @@ fn res_block(
         Some(res) => conv_same(res, x, lay, out, Accumulate::Add, wbuf),
         // Pads are zero in both, so whole rows add.
         None => {
-            for (o, v) in out[..cout * lay.row()].iter_mut().zip(&x[..cout * lay.row()]) {
+            for (o, v) in out.iter_mut().zip(x).take(cout * lay.row()) {
                 *o += v;
             }
         }
