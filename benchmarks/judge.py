@@ -1,0 +1,555 @@
+"""The independent PyBullet judge: does each plan solve its problem?
+
+Applies `shared/spec/formats.md`, "What counts as a solved problem", to every plan with
+PyBullet 3.2.7 and none of the project's code:
+
+1. the first waypoint equals `start` and the last the joint goal, within 1e-4 rad each; for a
+   pose goal the TCP (`panda_grasptarget`) is within 5 mm and 5 degrees of the goal pose;
+2. every waypoint lies inside the spec's joint limits (tolerance 1e-5 rad);
+3. no contact (a `getClosestPoints` distance <= 0, touching included) between any robot link
+   but link0 (links 1-7, hand, both fingers) or the held object and any obstacle, and none
+   between two robot bodies that are not chain neighbours (link7, hand, fingers and held object
+   are one rigid group), at every waypoint and every state of the linear joint-space
+   interpolation between consecutive waypoints: ceil(max |dq| / 0.01) steps per segment
+   (at least 1), states at fractions k / steps.
+
+The robot is pybullet_data's `franka_panda/panda.urdf`, loaded only after checking that it and
+its collision meshes are byte-identical to the repository's `weights/panda/` (the repository
+copy lacks the visual meshes PyBullet needs to load it), with a fixed base at the origin and
+both fingers at 0.025 m. Obstacles and the held object are true PyBullet primitives (boxes,
+cylinders along local z, spheres); the held object is its own body whose pose is reset from
+the `panda_hand` link's world pose at every state. States are set with `resetJointState` (no
+physics stepping), followed by `performCollisionDetection`, then the queries.
+The collision check of a plan stops at its first contact.
+
+Inputs: a problem directory (`<problems>/<family>/<NNN>.json`, `edmp-scene/1`) and either a
+plan directory of the same layout (`<plans>/<family>/<NNN>.json`, `edmp-plan/1`) or a JSONL
+file of results (one JSON object per line: `problem` relative to the problem directory, e.g.
+"cubby/003.json", `status`, `waypoints` (50 x 7; empty, null or absent when the planner gave
+nothing), optional `planner`; other fields are ignored), such as the `results.jsonl` that
+`edmp-host bench --out DIR` writes (`--results DIR` reads DIR/results.jsonl).
+
+Output: a Markdown table per planner and family on standard output: plans judged, the
+planner's own "success" count, solved by the judge, false successes (planner said "success"
+and the judge finds a violated rule; listed below the table with their first contact) and
+false failures (planner said something else, gave waypoints, and the judge finds no contact;
+listed with their closest approach within 10 mm, from a second pass at positive distance).
+`--json OUT` writes every verdict (failed rules, end errors, the first limit violation, the
+first contact: segment, step, link, obstacle index or other link, distance; the closest
+approach of false failures). Exit status: 0 when there is no false success, 1 when there is one,
+2 on bad input.
+
+Usage (from the repository root):
+    python3 -m pip install -r benchmarks/requirements.txt
+    cargo build --release -p edmp-host
+    for f in tabletop cubby merged_cubby dresser; do
+      mkdir -p /tmp/plans/$f
+      for i in $(seq -f %03g 0 19); do
+        ./target/release/edmp-host plan benchmarks/problems/$f/$i.json -o /tmp/plans/$f/$i.json
+      done
+    done
+    python3 benchmarks/judge.py --plans /tmp/plans --json /tmp/verdicts.json
+    python3 benchmarks/judge.py --results RUN_DIR/results.jsonl --jobs 2  # from `edmp-host bench --out RUN_DIR`
+    python3 -m pytest benchmarks/test_judge.py -q                   # the judge's own tests
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import multiprocessing
+import os
+import pathlib
+import sys
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+
+def _import_pybullet() -> Any:
+    """Import pybullet with its build-time banner sent to standard error, not into the table."""
+    import ctypes
+
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        import pybullet
+
+        ctypes.CDLL(None).fflush(None)
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+    return pybullet
+
+
+p = _import_pybullet()
+import pybullet_data  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+URDF = ROOT / "weights" / "panda" / "panda.urdf"
+FINGER_OPENING = 0.025
+JOINT_TOLERANCE = 1e-4
+LIMIT_TOLERANCE = 1e-5
+POSITION_TOLERANCE = 0.005
+ANGLE_TOLERANCE = math.radians(5.0)
+MAX_STEP = 0.01
+CLEARANCE_WITHIN = 0.01  # how far the closest-approach pass of false failures looks (m)
+HORIZON = 50
+# Franka's official limits, as spec/formats.md lists them (the URDF's safety_controller).
+LIMITS = [
+    (-2.8973, 2.8973),
+    (-1.7628, 1.7628),
+    (-2.8973, 2.8973),
+    (-3.0718, -0.0698),
+    (-2.8973, 2.8973),
+    (-0.0175, 3.7525),
+    (-2.8973, 2.8973),
+]
+HELD = "held_object"
+
+
+@dataclass
+class Robot:
+    """One PyBullet client with the Panda loaded."""
+
+    client: int
+    body: int
+    revolute: list[int]
+    prismatic: list[int]
+    names: dict[int, str]  # link index (-1 = base) -> URDF link name
+    moving: list[int]  # links with collision geometry, base excluded
+    self_pairs: list[tuple[int, int]]  # non-neighbour link pairs with geometry
+    held_partners: list[int]  # links the held object may not touch (not neighbours of the hand group)
+    hand: int
+    tcp: int
+
+
+def level(name: str) -> int:
+    """Revolute joints between a link and the base: link k has k; link8, hand, fingers and the
+    held object share link7's 7. Bodies whose levels differ by at most one are neighbours."""
+    if name.startswith("panda_link") and name[-1].isdigit():
+        return min(int(name[-1]), 7)
+    return 7
+
+
+def packaged_urdf() -> pathlib.Path:
+    """pybullet_data's Panda, after checking it is the repository's robot byte for byte."""
+    data = pathlib.Path(pybullet_data.getDataPath()) / "franka_panda"
+    packaged = data / "panda.urdf"
+    if packaged.read_bytes() != URDF.read_bytes():
+        raise SystemExit(f"{packaged} differs from {URDF}: the judge would collide another robot")
+    for mesh in sorted((URDF.parent / "meshes" / "collision").glob("*.obj")):
+        theirs = data / "meshes" / "collision" / mesh.name
+        if not theirs.exists() or theirs.read_bytes() != mesh.read_bytes():
+            raise SystemExit(f"{theirs} differs from {mesh}: the judge would collide another robot")
+    return packaged
+
+
+def connect() -> Robot:
+    packaged = packaged_urdf()
+    client = p.connect(p.DIRECT)
+    body = p.loadURDF(str(packaged), basePosition=[0, 0, 0], useFixedBase=True, physicsClientId=client)
+    n = p.getNumJoints(body, physicsClientId=client)
+    infos = [p.getJointInfo(body, j, physicsClientId=client) for j in range(n)]
+    revolute = [j for j in range(n) if infos[j][2] == p.JOINT_REVOLUTE]
+    prismatic = [j for j in range(n) if infos[j][2] == p.JOINT_PRISMATIC]
+    assert len(revolute) == 7 and len(prismatic) == 2, (revolute, prismatic)
+    names = {-1: "panda_link0", **{j: infos[j][12].decode() for j in range(n)}}
+    index = {name: j for j, name in names.items()}
+    geometry = [j for j in [-1, *range(n)] if p.getCollisionShapeData(body, j, physicsClientId=client)]
+    pairs = [(a, b) for i, a in enumerate(geometry) for b in geometry[i + 1 :] if abs(level(names[a]) - level(names[b])) >= 2]
+    held_partners = [j for j in geometry if level(names[j]) <= 5]
+    return Robot(
+        client=client,
+        body=body,
+        revolute=revolute,
+        prismatic=prismatic,
+        names=names,
+        moving=[j for j in geometry if j != -1],
+        self_pairs=pairs,
+        held_partners=held_partners,
+        hand=index["panda_hand"],
+        tcp=index["panda_grasptarget"],
+    )
+
+
+def xyzw(wxyz: list[float]) -> list[float]:
+    w, x, y, z = wxyz
+    return [x, y, z, w]
+
+
+def spawn(robot: Robot, o: dict[str, Any]) -> int:
+    c = robot.client
+    if o["type"] == "cuboid":
+        shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=[d / 2 for d in o["dims"]], physicsClientId=c)
+    elif o["type"] == "cylinder":
+        shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=o["radius"], height=o["height"], physicsClientId=c)
+    elif o["type"] == "sphere":
+        shape = p.createCollisionShape(p.GEOM_SPHERE, radius=o["radius"], physicsClientId=c)
+    else:
+        raise ValueError(f"unknown primitive type {o['type']!r}")
+    orientation = xyzw(o.get("quaternion", [1, 0, 0, 0]))
+    return p.createMultiBody(0, shape, basePosition=o["center"], baseOrientation=orientation, physicsClientId=c)
+
+
+def set_state(robot: Robot, q: np.ndarray) -> None:
+    for j, value in zip(robot.revolute, q):
+        p.resetJointState(robot.body, j, float(value), physicsClientId=robot.client)
+    for j in robot.prismatic:
+        p.resetJointState(robot.body, j, FINGER_OPENING, physicsClientId=robot.client)
+
+
+def link_pose(robot: Robot, link: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """World pose of a link's URDF frame (position, quaternion xyzw)."""
+    state = p.getLinkState(robot.body, link, computeForwardKinematics=True, physicsClientId=robot.client)
+    return state[4], state[5]
+
+
+def closest(c: int, a: int, b: int, within: float, link_a: int | None = None, link_b: int | None = None) -> float | None:
+    """Smallest getClosestPoints distance <= `within` between two bodies (links), else None."""
+    kwargs = {}
+    if link_a is not None:
+        kwargs["linkIndexA"] = link_a
+    if link_b is not None:
+        kwargs["linkIndexB"] = link_b
+    points = p.getClosestPoints(a, b, within, physicsClientId=c, **kwargs)
+    near = [pt[8] for pt in points if pt[8] <= within]
+    return min(near) if near else None
+
+
+def place(robot: Robot, q: np.ndarray, held: int | None, held_pose: Any) -> None:
+    """Sets the arm (and the held object from the hand's pose), then collision detection."""
+    set_state(robot, q)
+    if held is not None:
+        hand_pos, hand_quat = link_pose(robot, robot.hand)
+        pos, quat = p.multiplyTransforms(hand_pos, hand_quat, held_pose[0], held_pose[1])
+        p.resetBasePositionAndOrientation(held, pos, quat, physicsClientId=robot.client)
+    p.performCollisionDetection(physicsClientId=robot.client)
+
+
+def queries(robot: Robot, obstacles: list[int], held: int | None) -> list[tuple[int, int, int | None, int | None, dict[str, Any]]]:
+    """Every checked pair as (body A, body B, link A, link B, description), obstacles first."""
+    out: list[tuple[int, int, int | None, int | None, dict[str, Any]]] = []
+    for k, obstacle in enumerate(obstacles):
+        for link in robot.moving:
+            out.append((robot.body, obstacle, link, None, {"kind": "obstacle", "link": robot.names[link], "obstacle": k}))
+        if held is not None:
+            out.append((held, obstacle, None, None, {"kind": "obstacle", "link": HELD, "obstacle": k}))
+    for a, b in robot.self_pairs:
+        out.append((robot.body, robot.body, a, b, {"kind": "self", "link": robot.names[a], "other": robot.names[b]}))
+    if held is not None:
+        for link in robot.held_partners:
+            out.append((held, robot.body, None, link, {"kind": "self", "link": HELD, "other": robot.names[link]}))
+    return out
+
+
+def contact_at(robot: Robot, q: np.ndarray, pairs: list, held: int | None, held_pose: Any) -> dict[str, Any] | None:
+    """The first contact (distance <= 0) found at configuration q, or None."""
+    place(robot, q, held, held_pose)
+    for a, b, link_a, link_b, what in pairs:
+        d = closest(robot.client, a, b, 0.0, link_a, link_b)
+        if d is not None:
+            return what | {"distance": d}
+    return None
+
+
+def nearest_at(robot: Robot, q: np.ndarray, pairs: list, held: int | None, held_pose: Any, within: float) -> dict[str, Any] | None:
+    """The closest pair at configuration q if nearer than `within`, or None."""
+    place(robot, q, held, held_pose)
+    best: dict[str, Any] | None = None
+    for a, b, link_a, link_b, what in pairs:
+        d = closest(robot.client, a, b, within, link_a, link_b)
+        if d is not None and (best is None or d < best["distance"]):
+            best = what | {"distance": d}
+    return best
+
+
+def segment_states(a: np.ndarray, b: np.ndarray) -> list[np.ndarray]:
+    """States a + (b - a) k / steps for k = 0 .. steps - 1 (the end belongs to the next segment)."""
+    steps = max(1, math.ceil(float(np.max(np.abs(b - a))) / MAX_STEP))
+    return [a + (b - a) * (k / steps) for k in range(steps)]
+
+
+def quaternion_angle(q1_xyzw: Any, q2_xyzw: Any) -> float:
+    dot = abs(sum(x * y for x, y in zip(q1_xyzw, q2_xyzw)))
+    return 2.0 * math.acos(min(1.0, dot))
+
+
+def judge(robot: Robot, scene: dict[str, Any], plan: dict[str, Any]) -> dict[str, Any]:
+    """The verdict on one plan: `solved`, the list of `failed` rules and their details."""
+    verdict: dict[str, Any] = {"solved": False, "failed": []}
+    waypoints = plan.get("waypoints")
+    try:
+        w = np.asarray(waypoints, dtype=np.float64)
+    except (TypeError, ValueError):
+        w = np.zeros((0,))
+    if waypoints is None or w.shape != (HORIZON, 7) or not np.all(np.isfinite(w)):
+        verdict["failed"] = ["malformed"]
+        verdict["detail"] = "no waypoints" if not waypoints else f"waypoints of shape {w.shape} or not finite, expected {HORIZON}x7"
+        return verdict
+    failed = verdict["failed"]
+
+    # Rule 1: the ends.
+    start_error = float(np.max(np.abs(w[0] - np.asarray(scene["start"], dtype=np.float64))))
+    verdict["start_error_rad"] = start_error
+    if not start_error <= JOINT_TOLERANCE:
+        failed.append("start")
+    goal = scene["goal"]
+    if "joints" in goal:
+        goal_error = float(np.max(np.abs(w[-1] - np.asarray(goal["joints"], dtype=np.float64))))
+        verdict["goal_error_rad"] = goal_error
+        if not goal_error <= JOINT_TOLERANCE:
+            failed.append("goal")
+    else:
+        set_state(robot, w[-1])
+        pos, quat = link_pose(robot, robot.tcp)
+        target = goal["pose"]
+        position_error = math.dist(pos, target["position"])
+        angle_error = quaternion_angle(quat, xyzw(target["quaternion"]))
+        verdict["goal_position_error_m"] = position_error
+        verdict["goal_angle_error_deg"] = math.degrees(angle_error)
+        if not (position_error <= POSITION_TOLERANCE and angle_error <= ANGLE_TOLERANCE):
+            failed.append("goal")
+
+    # Rule 2: the joint limits.
+    for i, q in enumerate(w):
+        for j, (lo, hi) in enumerate(LIMITS):
+            if not lo - LIMIT_TOLERANCE <= q[j] <= hi + LIMIT_TOLERANCE:
+                verdict["limit_violation"] = {"waypoint": i, "joint": j + 1, "value": float(q[j]), "limits": [lo, hi]}
+                break
+        if "limit_violation" in verdict:
+            failed.append("limits")
+            break
+
+    # Rule 3: contact along the interpolated trajectory.
+    verdict["states_checked"] = 0
+    with contextlib.closing(walk(robot, scene, w, contact_at)) as states:
+        for segment, step, steps, hit in states:
+            verdict["states_checked"] += 1
+            if hit is not None:
+                verdict["first_contact"] = {"segment": segment, "step": step, "steps": steps, **hit}
+                failed.append("contact")
+                break
+    verdict["solved"] = not failed
+    return verdict
+
+
+def walk(robot: Robot, scene: dict[str, Any], w: np.ndarray, query: Any, **kwargs: Any) -> Any:
+    """Yields (segment, step, steps, query result) at every checked state, the scene's bodies
+    spawned for the walk and removed after it."""
+    obstacles = [spawn(robot, o) for o in scene.get("obstacles", [])]
+    held, held_pose = None, None
+    if scene.get("held_object"):
+        h = scene["held_object"]
+        held = spawn(robot, h | {"center": [0, 0, -100]})
+        held_pose = (h["center"], xyzw(h.get("quaternion", [1, 0, 0, 0])))
+    try:
+        pairs = queries(robot, obstacles, held)
+        for segment in range(len(w)):
+            along = segment_states(w[segment], w[segment + 1]) if segment + 1 < len(w) else [w[segment]]
+            for step, q in enumerate(along):
+                yield segment, step, len(along), query(robot, q, pairs, held, held_pose, **kwargs)
+    finally:
+        for body in obstacles + ([held] if held is not None else []):
+            p.removeBody(body, physicsClientId=robot.client)
+
+
+def clearance(robot: Robot, scene: dict[str, Any], waypoints: Any, within: float = 0.01) -> dict[str, Any] | None:
+    """The closest approach of any checked pair along the plan (None: nothing within `within`
+    metres). A second, slower pass, run for plans the planner called failures although the
+    judge finds no contact: it shows how near they came (the project's checker keeps a margin)."""
+    best: dict[str, Any] | None = None
+    for segment, step, steps, near in walk(robot, scene, np.asarray(waypoints, dtype=np.float64), nearest_at, within=within):
+        if near is not None and (best is None or near["distance"] < best["distance"]):
+            best = {"segment": segment, "step": step, "steps": steps, **near}
+    return best
+
+
+# ---- the command line ----------------------------------------------------------------------
+
+_ROBOT: Robot | None = None
+
+
+def _init_worker() -> None:
+    global _ROBOT
+    _ROBOT = connect()
+
+
+def _judge_job(job: dict[str, Any]) -> dict[str, Any]:
+    assert _ROBOT is not None
+    scene = json.loads(pathlib.Path(job["problem_path"]).read_text())
+    verdict = judge(_ROBOT, scene, {"waypoints": job["waypoints"]})
+    if is_false_failure(job | verdict):
+        verdict["closest_approach"] = clearance(_ROBOT, scene, job["waypoints"], CLEARANCE_WITHIN)
+    return {k: v for k, v in job.items() if k not in ("waypoints", "problem_path")} | verdict
+
+
+def load_jobs(problems: pathlib.Path, plans: pathlib.Path | None, results: pathlib.Path | None, label: str | None = None) -> list[dict[str, Any]]:
+    jobs = []
+    if plans is not None:
+        for path in sorted(plans.glob("*/*.json")):
+            plan = json.loads(path.read_text())
+            rel = path.relative_to(plans).as_posix()
+            jobs.append(
+                {
+                    "problem": rel,
+                    "planner": label or plan.get("planner", plans.name),
+                    "status": plan.get("status"),
+                    "waypoints": plan.get("waypoints"),
+                }
+            )
+    if results is not None:
+        if results.is_dir():  # an `edmp-host bench --out` folder
+            results = results / "results.jsonl"
+        for n, line in enumerate(results.read_text().splitlines(), 1):
+            if not line.strip():
+                continue
+            try:
+                row = json.loads(line)
+                jobs.append({"problem": row["problem"], "planner": label or row.get("planner", "-"), "status": row.get("status"), "waypoints": row.get("waypoints")})
+            except (json.JSONDecodeError, KeyError, TypeError) as e:
+                raise SystemExit(f"{results}:{n}: bad result line ({e})") from None
+    for job in jobs:
+        path = problems / job["problem"]
+        if not path.is_file():
+            raise SystemExit(f"no problem {path} for the plan of {job['problem']}")
+        job["problem_path"] = str(path)
+        job["family"] = pathlib.PurePosixPath(job["problem"]).parent.as_posix()
+    return jobs
+
+
+def summarize(verdicts: list[dict[str, Any]]) -> tuple[str, int]:
+    """The Markdown tables (one per planner) and the number of false successes."""
+    lines = []
+    false_total = 0
+    for planner in sorted({v["planner"] for v in verdicts}):
+        lines += [
+            f"### {planner}",
+            "",
+            "| family | plans judged | planner \"success\" | solved by the judge | false successes | false failures |",
+            "|---|---|---|---|---|---|",
+        ]
+        mine = [v for v in verdicts if v["planner"] == planner]
+        families = sorted({v["family"] for v in mine})
+        for family in [*families, None]:
+            rows = [v for v in mine if family is None or v["family"] == family]
+            claimed = sum(v["status"] == "success" for v in rows)
+            solved = sum(v["solved"] for v in rows)
+            false_success = [v for v in rows if v["status"] == "success" and not v["solved"]]
+            false_failure = sum(map(is_false_failure, rows))
+            name = family if family is not None else "**all**"
+            lines.append(f"| {name} | {len(rows)} | {claimed} | {solved} | {len(false_success)} | {false_failure} |")
+            if family is None:
+                false_total += len(false_success)
+        lines.append("")
+        bad = [v for v in mine if v["status"] == "success" and not v["solved"]]
+        if bad:
+            lines.append("False successes:")
+            lines.append("")
+            for v in sorted(bad, key=lambda v: v["problem"]):
+                lines.append(f"- {v['problem']}: {describe(v)}")
+            lines.append("")
+        missed = [v for v in mine if is_false_failure(v)]
+        if missed:
+            lines.append(f"False failures (planner said failure, PyBullet finds no contact; closest approach within {CLEARANCE_WITHIN * 1000:.0f} mm):")
+            lines.append("")
+            for v in sorted(missed, key=lambda v: v["problem"]):
+                lines.append(f"- {v['problem']} ({v['status']}): {describe_near(v.get('closest_approach'))}")
+            lines.append("")
+    return "\n".join(lines), false_total
+
+
+def is_false_failure(v: dict[str, Any]) -> bool:
+    """The planner gave up (any status but "success") on waypoints that PyBullet finds free."""
+    return v["status"] != "success" and "malformed" not in v["failed"] and "contact" not in v["failed"]
+
+
+def describe_near(c: dict[str, Any] | None) -> str:
+    if c is None:
+        return f"nothing within {CLEARANCE_WITHIN * 1000:.0f} mm"
+    what = f"obstacle {c['obstacle']}" if c["kind"] == "obstacle" else c["other"]
+    return f"{c['link']} / {what} at segment {c['segment']} step {c['step']}/{c['steps']}, {c['distance'] * 1000:.3f} mm"
+
+
+def describe(v: dict[str, Any]) -> str:
+    parts = []
+    for rule in v["failed"]:
+        if rule == "contact":
+            c = v["first_contact"]
+            what = f"obstacle {c['obstacle']}" if c["kind"] == "obstacle" else c["other"]
+            parts.append(f"contact {c['link']} / {what} at segment {c['segment']} step {c['step']}/{c['steps']}, distance {c['distance'] * 1000:.3f} mm")
+        elif rule == "limits":
+            lv = v["limit_violation"]
+            parts.append(f"joint {lv['joint']} = {lv['value']:.6f} outside {lv['limits']} at waypoint {lv['waypoint']}")
+        elif rule == "start":
+            parts.append(f"start off by {v['start_error_rad']:.2e} rad")
+        elif rule == "goal":
+            if "goal_error_rad" in v:
+                parts.append(f"goal off by {v['goal_error_rad']:.2e} rad")
+            else:
+                parts.append(f"goal off by {v['goal_position_error_m'] * 1000:.2f} mm, {v['goal_angle_error_deg']:.2f} deg")
+        else:
+            parts.append(v.get("detail", rule))
+    return "; ".join(parts)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--problems", type=pathlib.Path, default=ROOT / "benchmarks" / "problems", help="problem directory (default: benchmarks/problems)")
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--plans", type=pathlib.Path, help="plan directory: <plans>/<family>/<NNN>.json")
+    source.add_argument("--results", type=pathlib.Path, help="JSONL file: one result per line (problem, status, waypoints, planner)")
+    parser.add_argument("--json", type=pathlib.Path, help="write every verdict to this JSON file")
+    parser.add_argument("--planner", help="label for the tables (default: the plans' or results' `planner` field, else the plan folder's name)")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes (default: number of CPUs)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    args = parser.parse_args(argv)
+
+    try:
+        packaged_urdf()
+        jobs = load_jobs(args.problems, args.plans, args.results, args.planner)
+    except (SystemExit, OSError, json.JSONDecodeError) as e:
+        print(f"judge: {e}", file=sys.stderr)
+        return 2
+    if not jobs:
+        print("judge: no plans found", file=sys.stderr)
+        return 2
+    bar = tqdm(total=len(jobs), unit="plan", disable=args.no_progress, file=sys.stderr)
+    verdicts = []
+    try:
+        if args.jobs <= 1:
+            _init_worker()
+            for job in jobs:
+                verdicts.append(_judge_job(job))
+                bar.update()
+        else:
+            with multiprocessing.Pool(min(args.jobs, len(jobs)), initializer=_init_worker) as pool:
+                for verdict in pool.imap_unordered(_judge_job, jobs):
+                    verdicts.append(verdict)
+                    bar.update()
+    except (KeyError, TypeError, ValueError, OSError) as e:  # a problem file the judge cannot read
+        bar.close()
+        print(f"judge: bad input: {type(e).__name__}: {e}", file=sys.stderr)
+        return 2
+    bar.close()
+    verdicts.sort(key=lambda v: (v["planner"], v["problem"]))
+    table, false_successes = summarize(verdicts)
+    print(table)
+    if args.json is not None:
+        args.json.write_text(json.dumps({"format": "edmp-judge/1", "pybullet": pybullet_version(), "verdicts": verdicts}, indent=1) + "\n")
+    return 1 if false_successes else 0
+
+
+def pybullet_version() -> str:
+    import importlib.metadata
+
+    return importlib.metadata.version("pybullet")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
