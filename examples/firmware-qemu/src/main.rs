@@ -57,7 +57,10 @@ const OBSTACLES: usize = 40;
 /// The embedded scenes, in `edmp-host embed`'s order (scripts/firmware lists the same files).
 const SCENES: &[(&str, &[u8])] = &[
     ("examples-wall", include_bytes!("../scenes/examples-wall.postcard")),
-    ("tabletop-000", include_bytes!("../scenes/tabletop-000.postcard")),
+    (
+        "examples-tabletop-pose-held",
+        include_bytes!("../scenes/examples-tabletop-pose-held.postcard"),
+    ),
     ("cubby-000", include_bytes!("../scenes/cubby-000.postcard")),
     ("dresser-000", include_bytes!("../scenes/dresser-000.postcard")),
 ];
