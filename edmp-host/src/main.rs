@@ -4,13 +4,16 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
-mod bench_plan;
+mod bench;
+mod bench_report;
 mod bench_rrt;
 mod embed;
 mod fk;
 mod gen_data;
 mod json;
+mod metrics;
 mod plan_cmd;
+mod plots;
 mod render;
 mod rrt;
 mod rrt_cmd;
@@ -36,8 +39,10 @@ enum Command {
     Rrt(rrt_cmd::Args),
     /// Generate the benchmark suite: MpiNets-style scenes and solvable problems.
     GenSuite(suite::Args),
-    /// Run EDMP over a problem folder and print a table per family.
-    BenchPlan(bench_plan::Args),
+    /// Run a planner over a problem folder: per-problem JSONL, a summary per family, charts.
+    Bench(bench::Args),
+    /// Compare `bench` runs: the paper's ablation tables and charts.
+    BenchReport(bench_report::Args),
     /// Run RRT-Connect over a problem folder and print a table per family.
     BenchRrt(bench_rrt::Args),
     /// Generate training trajectories (RRT-Connect in generated scenes) as a `.npy` file.
@@ -65,7 +70,8 @@ fn main() -> ExitCode {
         Command::Fk(args) => fk::run(&args).map_err(Failure::Input),
         Command::Rrt(args) => rrt_cmd::run(&args),
         Command::GenSuite(args) => suite::run(&args).map_err(Failure::Input),
-        Command::BenchPlan(args) => bench_plan::run(&args),
+        Command::Bench(args) => bench::run(&args),
+        Command::BenchReport(args) => bench_report::run(&args).map_err(Failure::Input),
         Command::BenchRrt(args) => bench_rrt::run(&args).map_err(Failure::Input),
         Command::GenData(args) => gen_data::run(&args).map_err(Failure::Input),
         Command::Render(args) => render::run(&args).map_err(Failure::Input),

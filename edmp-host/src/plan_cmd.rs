@@ -42,7 +42,7 @@ pub(crate) struct Args {
     tuning: Tuning,
 }
 
-/// The planner's knobs, shared by `plan` and `bench-plan`.
+/// The planner's knobs, shared by `plan` and `bench`.
 #[derive(Debug, Clone, clap::Args)]
 pub(crate) struct Tuning {
     /// Denoising steps K of the strided sampler.
@@ -101,11 +101,19 @@ impl Tuning {
 
     /// A short label for tables.
     pub(crate) fn label(&self) -> String {
+        let limit = if self.step_limit.is_finite() {
+            format!("step limit {} rad", self.step_limit)
+        } else {
+            "no step limit".to_owned()
+        };
         if self.ancestral {
-            "ancestral K = 255, guidance on even t".to_owned()
+            format!(
+                "ancestral K = 255, guidance on even t, {} refinement steps, {limit}",
+                self.refine_steps
+            )
         } else {
             format!(
-                "strided K = {}, {} gradient steps per step, {} refinement steps",
+                "strided K = {}, {} gradient steps per step, {} refinement steps, {limit}",
                 self.steps, self.gradient_steps, self.refine_steps
             )
         }

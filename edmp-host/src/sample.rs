@@ -7,6 +7,7 @@
 //! trajectories; `--plot` draws some samples, joint by joint, to a PNG.
 
 use crate::json::{Goal, parse_problem};
+use crate::metrics::{Roughness, roughness, step_norm};
 use crate::render::Canvas;
 use edmp_core::checker::{CheckConfig, check_trajectory};
 use edmp_core::prior::{HORIZON, Path, Sampler, Scratch, sample};
@@ -85,24 +86,12 @@ fn name(sampler: Sampler) -> String {
 /// Per-trajectory measurements.
 #[derive(Clone, Copy, Default)]
 struct Quality {
-    ar: f64,
-    mresg: f64,
-    rf2w: f64,
-    rl2w: f64,
+    roughness: Roughness,
     outside_limits: bool,
     self_colliding: bool,
 }
 
-fn step_norm(a: &[f32; JOINTS], b: &[f32; JOINTS]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| f64::from(x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
-
 fn quality(x: &Path, empty: &Scene<1>) -> Quality {
-    let steps: Vec<f64> = x.windows(2).map(|w| step_norm(&w[0], &w[1])).collect();
     let outside_limits = x.iter().flatten().enumerate().any(|(i, v)| {
         let j = i % JOINTS;
         *v < PANDA.hard_lower[j] || *v > PANDA.hard_upper[j]
@@ -113,10 +102,7 @@ fn quality(x: &Path, empty: &Scene<1>) -> Quality {
     };
     let self_colliding = check_trajectory(empty, x, &config, true).map_or(true, |r| !r.is_free());
     Quality {
-        ar: steps.iter().sum::<f64>() / steps.len() as f64,
-        mresg: steps[1..steps.len() - 1].iter().copied().fold(0.0, f64::max),
-        rf2w: steps[0],
-        rl2w: steps[steps.len() - 1],
+        roughness: roughness(x),
         outside_limits,
         self_colliding,
     }
@@ -130,10 +116,10 @@ fn row(label: &str, q: &[Quality], ms: Option<(f64, f64)>) -> String {
     format!(
         "| {label} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.1} | {:.1} | {time} |",
         q.len(),
-        mean(|x| x.ar),
-        mean(|x| x.mresg),
-        mean(|x| x.rf2w),
-        mean(|x| x.rl2w),
+        mean(|x| x.roughness.ar),
+        mean(|x| x.roughness.mresg),
+        mean(|x| x.roughness.rf2w),
+        mean(|x| x.roughness.rl2w),
         share(|x| x.outside_limits),
         share(|x| x.self_colliding),
     )

@@ -215,8 +215,8 @@ fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
 /// constructors (independent of the host's parser).
 fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene {
     use edmp_core::scene::{Obstacle, Scene};
-    let v3 = |v: &serde_json::Value| -> [f32; 3] { std::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
-    let v4 = |v: &serde_json::Value| -> [f32; 4] { std::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
+    let v3 = |v: &serde_json::Value| -> [f32; 3] { core::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
+    let v4 = |v: &serde_json::Value| -> [f32; 4] { core::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
     let primitive = |o: &serde_json::Value| -> Obstacle {
         let c = v3(&o["center"]);
         match o["type"].as_str().unwrap() {
@@ -243,7 +243,7 @@ fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene {
 }
 
 fn joints(v: &serde_json::Value) -> [f32; 7] {
-    std::array::from_fn(|i| v[i].as_f64().unwrap() as f32)
+    core::array::from_fn(|i| v[i].as_f64().unwrap() as f32)
 }
 
 #[test]
@@ -302,7 +302,7 @@ fn every_example_plans_a_collision_free_path_from_its_start_to_its_goal() {
                 .all(|q| edmp_core::robot::PANDA.within_soft_limits(q, 0.0)),
             "{name}: outside the limits"
         );
-        let trajectory: [[f32; 7]; 50] = std::array::from_fn(|i| waypoints[i]);
+        let trajectory: [[f32; 7]; 50] = core::array::from_fn(|i| waypoints[i]);
         let report = edmp_core::checker::check_trajectory(
             &scene_of(&doc),
             &trajectory,
@@ -338,5 +338,68 @@ fn plan_exits_1_and_still_writes_the_least_colliding_plan_when_no_candidate_is_f
     let plan: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     assert_eq!(plan["status"], "collision");
     assert_eq!(plan["waypoints"].as_array().unwrap().len(), 50);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bench_writes_results_summary_and_charts_and_bench_report_compares_runs() {
+    let dir = std::env::temp_dir().join(format!("edmp-bench-{}", std::process::id()));
+    let (edmp, single, rrt, report) = (
+        dir.join("edmp"),
+        dir.join("single"),
+        dir.join("rrt"),
+        dir.join("report"),
+    );
+    for (out, extra) in [
+        (&edmp, vec![]),
+        (&single, vec!["--guides", "1"]),
+        (&rrt, vec!["--planner", "rrt-connect"]),
+    ] {
+        let mut args = vec!["bench", "--per-family", "1", "-o", out.to_str().unwrap()];
+        args.extend(extra);
+        let run = edmp_host(&args);
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        for file in ["results.jsonl", "summary.md", "success.png", "time.png"] {
+            assert!(out.join(file).exists(), "{}: no {file}", out.display());
+        }
+        let text = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+        let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+        assert_eq!(lines.len(), 4, "one problem per family");
+        for line in &lines {
+            assert!(["success", "collision", "failure"].contains(&line["status"].as_str().unwrap()));
+            assert!(line["time_ms"].as_f64().unwrap() > 0.0);
+            assert!(line["problem"].as_str().unwrap().ends_with(".json"));
+            if line["status"] == "success" {
+                assert_eq!(line["waypoints"].as_array().unwrap().len(), 50);
+            }
+        }
+    }
+    let first: serde_json::Value = serde_json::from_str(
+        std::fs::read_to_string(edmp.join("results.jsonl"))
+            .unwrap()
+            .lines()
+            .next()
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(first["candidates"].as_array().unwrap().len(), 12);
+    assert_eq!(first["guides"].as_array().unwrap().len(), 12);
+    let run = edmp_host(&[
+        "bench-report",
+        edmp.to_str().unwrap(),
+        single.to_str().unwrap(),
+        rrt.to_str().unwrap(),
+        "-o",
+        report.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(
+        md.contains("Table III") && md.contains("Figure 6") && md.contains("Figure 7"),
+        "{md}"
+    );
+    for file in ["success.png", "time.png", "guides.png", "winners.png"] {
+        assert!(report.join(file).exists(), "no {file}");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
