@@ -106,7 +106,7 @@ pub fn zero_gradient() -> CornerGradient<f32> {
 pub mod reference {
     use core::hash::{Hash, Hasher};
     use edmp_core::cost::{CostConfig, CostKind};
-    use edmp_core::geometry::box_dims;
+    use edmp_core::geometry::{BoxFrame, box_dims};
     use edmp_core::kinematics::forward;
     use edmp_core::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
     use edmp_core::scene::Scene;
@@ -165,23 +165,64 @@ pub mod reference {
             .collect()
     }
 
-    fn robot_boxes(q: &[f64; JOINTS], scene: &Scene<16>, cfg: &CostConfig, sig: &mut Choices) -> Vec<Box3> {
+    /// Every moving robot box's 8 world corners at `q` (bodies off the root, then the held object).
+    fn robot_corners(q: &[f64; JOINTS], scene: &Scene<16>, cfg: &CostConfig) -> Vec<Vec<Vector3<f64>>> {
         let k = forward(q).expect("finite");
         let mut out = Vec::new();
         for b in 0..BODIES {
             if PANDA.bodies[b].frame == 0 {
                 continue;
             }
-            out.push(aabb(&k.corners(b), sig));
+            out.push(k.corners(b).to_vec());
         }
         if let Some(h) = scene.held() {
             let half = box_dims(&h.shape, cfg.cylinder).cast::<f64>() * 0.5;
             let hand = &k.frames[HAND_FRAME];
             let local = corners(h.center.cast(), h.rotation.cast(), half);
-            let world: Vec<_> = local.iter().map(|p| hand.transform_point(p)).collect();
-            out.push(aabb(&world, sig));
+            out.push(local.iter().map(|p| hand.transform_point(p)).collect());
         }
         out
+    }
+
+    /// An obstacle as the cost compares it: a frame (world → frame coordinates) and its box there.
+    struct Costed {
+        /// The frame's axes (columns) and origin in the world.
+        axes: nalgebra::Matrix3<f64>,
+        origin: Vector3<f64>,
+        bounds: Box3,
+    }
+
+    fn costed(o: &edmp_core::scene::Obstacle, cfg: &CostConfig) -> Costed {
+        let dims = box_dims(&o.shape, cfg.cylinder)
+            .cast::<f64>()
+            .map(|d| d.max(f64::from(cfg.inflation.expansion)) + f64::from(cfg.inflation.clearance));
+        match cfg.frame {
+            BoxFrame::World => {
+                let pts = corners(o.center.cast(), o.rotation.cast(), dims * 0.5);
+                let mut lo = pts[0];
+                let mut hi = pts[0];
+                for p in &pts {
+                    lo = lo.inf(p);
+                    hi = hi.sup(p);
+                }
+                Costed {
+                    axes: nalgebra::Matrix3::identity(),
+                    origin: Vector3::zeros(),
+                    bounds: (lo, hi),
+                }
+            }
+            BoxFrame::Obstacle => Costed {
+                axes: o.rotation.cast(),
+                origin: o.center.cast(),
+                bounds: (-dims * 0.5, dims * 0.5),
+            },
+        }
+    }
+
+    /// The AABB, in the obstacle's frame, of a box given by its world corners.
+    fn boxed_in(corners: &[Vector3<f64>], o: &Costed, sig: &mut Choices) -> Box3 {
+        let local: Vec<Vector3<f64>> = corners.iter().map(|p| o.axes.transpose() * (p - o.origin)).collect();
+        aabb(&local, sig)
     }
 
     fn volume(a: &Box3, o: &Box3, sig: &mut Choices) -> f64 {
@@ -224,51 +265,34 @@ pub mod reference {
             sig: DefaultHasher::new(),
             margin: f64::INFINITY,
         };
-        let obstacles: Vec<Box3> = scene
-            .obstacles()
-            .iter()
-            .map(|o| {
-                let dims = box_dims(&o.shape, cfg.cylinder)
-                    .cast::<f64>()
-                    .map(|d| d.max(f64::from(cfg.inflation.expansion)) + f64::from(cfg.inflation.clearance));
-                let pts = corners(o.center.cast(), o.rotation.cast(), dims * 0.5);
-                let mut lo = pts[0];
-                let mut hi = pts[0];
-                for p in &pts {
-                    lo = lo.inf(p);
-                    hi = hi.sup(p);
-                }
-                (lo, hi)
-            })
-            .collect();
-        let boxes: Vec<Vec<Box3>> = trajectory
-            .iter()
-            .map(|q| robot_boxes(q, scene, cfg, &mut sig))
-            .collect();
+        let obstacles: Vec<Costed> = scene.obstacles().iter().map(|o| costed(o, cfg)).collect();
+        let bodies: Vec<Vec<Vec<Vector3<f64>>>> = trajectory.iter().map(|q| robot_corners(q, scene, cfg)).collect();
         let h = trajectory.len();
         let mut total = 0.0;
         match cfg.kind {
             CostKind::Intersection => {
-                for w in boxes.iter().take(h - 1).skip(1) {
-                    for b in w {
+                for w in bodies.iter().take(h - 1).skip(1) {
+                    for body in w {
                         for o in &obstacles {
-                            total += volume(b, o, &mut sig);
+                            let b = boxed_in(body, o, &mut sig);
+                            total += volume(&b, &o.bounds, &mut sig);
                         }
                     }
                 }
             }
             CostKind::Swept => {
-                for pair in boxes.windows(2) {
-                    for (a, b) in pair[0].iter().zip(pair[1].iter()) {
-                        for k in 0..3 {
-                            sig.record(
-                                (b.0[k] < a.0[k], b.1[k] > a.1[k]),
-                                (b.0[k] - a.0[k]).abs().min((b.1[k] - a.1[k]).abs()),
-                            );
-                        }
-                        let swept = (a.0.inf(&b.0), a.1.sup(&b.1));
+                for pair in bodies.windows(2) {
+                    for (ca, cb) in pair[0].iter().zip(pair[1].iter()) {
                         for o in &obstacles {
-                            total += volume(&swept, o, &mut sig);
+                            let (a, b) = (boxed_in(ca, o, &mut sig), boxed_in(cb, o, &mut sig));
+                            for k in 0..3 {
+                                sig.record(
+                                    (b.0[k] < a.0[k], b.1[k] > a.1[k]),
+                                    (b.0[k] - a.0[k]).abs().min((b.1[k] - a.1[k]).abs()),
+                                );
+                            }
+                            let swept = (a.0.inf(&b.0), a.1.sup(&b.1));
+                            total += volume(&swept, &o.bounds, &mut sig);
                         }
                     }
                 }

@@ -6,7 +6,7 @@ use core::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use edmp_core::checker::{CheckConfig, check_trajectory};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
-use edmp_core::geometry::{CylinderBox, Inflation};
+use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
 use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
 
@@ -78,6 +78,7 @@ fn bench(c: &mut Criterion) {
                 expansion: 0.2,
             },
             cylinder: CylinderBox::Enclosing,
+            frame: BoxFrame::Obstacle,
         };
         let total: f32 = batch
             .iter()

@@ -1,26 +1,28 @@
 //! EDMP's collision costs on a trajectory, with their hand-written adjoint.
 //!
 //! Every moving robot body (collision bodies not attached to the fixed root, plus the held
-//! object) is replaced by the world AABB of its oriented box's 8 corners (for the robot's
-//! boxes computed directly as `centre ± |R|·half`); every obstacle by the
-//! world AABB of its inflated box ([`obstacle_aabb`]). Then, as in the original code:
+//! object) is an oriented box; every obstacle the box of its inflated primitive. Each (body,
+//! obstacle) pair is compared in one frame ([`BoxFrame`]): the obstacle's own (default; the
+//! obstacle box is exact there and the body's box is boxed along its axes as
+//! `centre ± |R|·half`) or the world's (the original code: both become world AABBs). Then, as
+//! in the original code:
 //! - **intersection volume** (iv): `Σ ∏ max(0, overlap)` over the interior waypoints
 //!   `1..H-1`, bodies and obstacles;
 //! - **swept volume** (sv): the same over the `H-1` segments, each body's box on a segment
 //!   being the union of its boxes at the two ends (start and goal included).
 //!
-//! The gradient runs backwards through the product, through the min/max that chose each AABB
+//! The gradient runs backwards through the product, through the min/max that chose each box
 //! bound (the arg-extremal corner, or the segment end that set a swept bound; ties go to the
 //! first), onto that corner as a point moving with its frame ([`Cotangent::add_point`]), and
 //! through [`Kinematics::joint_gradient`]. Waypoints whose boxes touch nothing get an exact
 //! zero without running the adjoint.
 
 use crate::error::Error;
-use crate::geometry::{Aabb, CylinderBox, Inflation, box_dims, obstacle_aabb};
+use crate::geometry::{Aabb, BoxFrame, CylinderBox, Inflation, box_dims, inflated_dims, obstacle_aabb};
 use crate::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward};
 use crate::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Obstacle, Scene};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Which of EDMP's two costs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,101 +42,141 @@ pub struct CostConfig {
     pub inflation: Inflation,
     /// How cylinders are boxed.
     pub cylinder: CylinderBox,
+    /// The frame each pair is boxed in.
+    pub frame: BoxFrame,
 }
 
 /// Robot box slots per waypoint: every collision body, then the held object.
 const SLOTS: usize = BODIES + 1;
 const HELD: usize = BODIES;
 
-/// The world AABBs of the robot at one waypoint, with the corner that set each bound.
+/// One obstacle as the costs see it: a frame and the inflated box in it, and a ball holding
+/// that box (broad phase).
 #[derive(Clone, Copy, Debug)]
-struct RobotBoxes {
-    aabb: [Aabb; SLOTS],
-    /// `[min corner per axis, max corner per axis]`.
-    arg: [[[u8; 3]; 2]; SLOTS],
-    active: [bool; SLOTS],
+struct ObstacleBox {
+    /// The frame's axes in world coordinates (columns); `None`: the world's own.
+    axes: Option<Matrix3<f32>>,
+    /// The frame's origin in the world.
+    origin: Vector3<f32>,
+    /// The box in that frame.
+    bounds: Aabb,
+    /// World centre and radius of a ball holding the box.
+    center: Vector3<f32>,
+    radius: f32,
 }
 
-const EMPTY: Aabb = Aabb {
-    min: Vector3::new(0.0, 0.0, 0.0),
-    max: Vector3::new(0.0, 0.0, 0.0),
+impl ObstacleBox {
+    fn new(o: &Obstacle, config: &CostConfig) -> Self {
+        match config.frame {
+            BoxFrame::World => {
+                let bounds = obstacle_aabb(o, &config.inflation, config.cylinder);
+                Self {
+                    axes: None,
+                    origin: Vector3::zeros(),
+                    bounds,
+                    center: (bounds.min + bounds.max) * 0.5,
+                    radius: (bounds.max - bounds.min).norm() * 0.5,
+                }
+            }
+            BoxFrame::Obstacle => {
+                let half = inflated_dims(o, &config.inflation, config.cylinder) * 0.5;
+                Self {
+                    axes: Some(o.rotation),
+                    origin: o.center,
+                    bounds: Aabb { min: -half, max: half },
+                    center: o.center,
+                    radius: half.norm(),
+                }
+            }
+        }
+    }
+
+    fn is_finite(&self) -> bool {
+        let v = [self.bounds.min, self.bounds.max, self.origin, self.center];
+        v.iter().flat_map(|x| x.iter()).all(|x| x.is_finite())
+            && self.radius.is_finite()
+            && self.axes.is_none_or(|a| a.iter().all(|x| x.is_finite()))
+    }
+
+    /// World direction of the frame's axis `k`.
+    fn axis(&self, k: usize) -> Vector3<f32> {
+        match &self.axes {
+            Some(a) => a.column(k).into_owned(),
+            None => Vector3::ith(k, 1.0),
+        }
+    }
+}
+
+/// One robot box at one waypoint.
+#[derive(Clone, Copy, Debug)]
+struct RobotBox {
+    pose: Pose<f32>,
+    half: Vector3<f32>,
+    /// Radius of a ball around the centre that holds the box's AABB in any frame
+    /// (`√3·|half|`: each AABB half extent is at most `|half|`).
+    reach: f32,
+    active: bool,
+}
+
+const IDLE: RobotBox = RobotBox {
+    pose: Pose {
+        rotation: Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+        translation: Vector3::new(0.0, 0.0, 0.0),
+    },
+    half: Vector3::new(0.0, 0.0, 0.0),
+    reach: 0.0,
+    active: false,
 };
 
-fn aabb_of(corners: &[Vector3<f32>; CORNERS]) -> (Aabb, [[u8; 3]; 2]) {
-    let mut b = Aabb {
-        min: corners[0],
-        max: corners[0],
-    };
-    let mut arg = [[0u8; 3]; 2];
-    for (c, p) in corners.iter().enumerate().skip(1) {
+impl RobotBox {
+    fn new(pose: Pose<f32>, half: Vector3<f32>) -> Self {
+        Self {
+            pose,
+            half,
+            reach: 1.732_051 * half.norm(),
+            active: true,
+        }
+    }
+
+    /// Whether the ball around the box can touch the obstacle's ball.
+    fn near(&self, o: &ObstacleBox) -> bool {
+        let r = self.reach + o.radius;
+        (self.pose.translation - o.center).norm_squared() <= r * r
+    }
+
+    /// The box's AABB in the obstacle's frame, with the corners that set its bounds: along
+    /// axis `k` the highest corner takes `+half_j` exactly where `M[k][j] > 0`.
+    fn aabb_in(&self, o: &ObstacleBox) -> (Aabb, [[u8; 3]; 2]) {
+        let (r, c) = match &o.axes {
+            Some(a) => (
+                a.transpose() * self.pose.rotation,
+                a.transpose() * (self.pose.translation - o.origin),
+            ),
+            None => (self.pose.rotation, self.pose.translation),
+        };
+        let reach = r.abs() * self.half;
+        let mut arg = [[0u8; 3]; 2];
         for k in 0..3 {
-            if p[k] < b.min[k] {
-                b.min[k] = p[k];
-                arg[0][k] = c as u8;
-            }
-            if p[k] > b.max[k] {
-                b.max[k] = p[k];
-                arg[1][k] = c as u8;
-            }
+            let high = u8::from(r[(k, 0)] > 0.0) | u8::from(r[(k, 1)] > 0.0) << 1 | u8::from(r[(k, 2)] > 0.0) << 2;
+            arg[1][k] = high;
+            arg[0][k] = !high & 0b111;
         }
+        (
+            Aabb {
+                min: c - reach,
+                max: c + reach,
+            },
+            arg,
+        )
     }
-    (b, arg)
 }
 
-/// World AABB of an oriented box, `centre ± |R|·half`, with the corners that set its bounds:
-/// along world axis `k` the highest corner takes `+half_j` exactly where `R[k][j] > 0`.
-fn box_aabb(pose: &Pose<f32>, half: &Vector3<f32>) -> (Aabb, [[u8; 3]; 2]) {
-    let r = &pose.rotation;
-    let reach = r.abs() * half;
-    let mut arg = [[0u8; 3]; 2];
-    for k in 0..3 {
-        let high = u8::from(r[(k, 0)] > 0.0) | u8::from(r[(k, 1)] > 0.0) << 1 | u8::from(r[(k, 2)] > 0.0) << 2;
-        arg[1][k] = high;
-        arg[0][k] = !high & 0b111;
+/// The held object's box in the hand frame.
+fn held_local_pose(held: &Obstacle) -> Pose<f32> {
+    Pose {
+        rotation: held.rotation,
+        translation: held.center,
     }
-    (
-        Aabb {
-            min: pose.translation - reach,
-            max: pose.translation + reach,
-        },
-        arg,
-    )
-}
-
-/// Corners of the held object's box in the hand frame.
-fn held_local_corners(held: &Obstacle, cylinder: CylinderBox) -> [Vector3<f32>; CORNERS] {
-    let h = box_dims(&held.shape, cylinder) * 0.5;
-    core::array::from_fn(|k| {
-        let s = Vector3::new(
-            if k & 1 == 1 { h.x } else { -h.x },
-            if k & 2 == 2 { h.y } else { -h.y },
-            if k & 4 == 4 { h.z } else { -h.z },
-        );
-        held.center + held.rotation * s
-    })
-}
-
-fn robot_boxes(k: &Kinematics<f32>, held: Option<&[Vector3<f32>; CORNERS]>) -> RobotBoxes {
-    let mut out = RobotBoxes {
-        aabb: [EMPTY; SLOTS],
-        arg: [[[0; 3]; 2]; SLOTS],
-        active: [false; SLOTS],
-    };
-    for b in 0..BODIES {
-        // Bodies on the fixed root (link0) never move and are not checked against obstacles.
-        if PANDA.bodies[b].frame == 0 {
-            continue;
-        }
-        (out.aabb[b], out.arg[b]) = box_aabb(&k.boxes[b], &PANDA.bodies[b].half_extents);
-        out.active[b] = true;
-    }
-    if let Some(local) = held {
-        let hand = &k.frames[HAND_FRAME];
-        let world = local.map(|p| hand.transform_point(&p));
-        (out.aabb[HELD], out.arg[HELD]) = aabb_of(&world);
-        out.active[HELD] = true;
-    }
-    out
 }
 
 /// Intersection volume of `a` with `o` and its gradient with respect to `a`'s bounds.
@@ -150,34 +192,46 @@ fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector
     Some((volume, d_min, d_max))
 }
 
-/// Gradient on the `[min, max]` bounds of each robot box at one waypoint.
-type BoundGradient = [[Vector3<f32>; 2]; SLOTS];
-const ZERO_BOUNDS: BoundGradient = [[Vector3::new(0.0, 0.0, 0.0); 2]; SLOTS];
-
 /// One waypoint on its way through the cost: its kinematics and boxes, and the gradient its
-/// boxes' bounds have collected so far (`touched` once anything was added).
+/// boxes' corners have collected so far (world vectors; `touched` once anything was added).
 #[derive(Clone, Copy, Debug)]
 struct Waypoint {
     k: Kinematics<f32>,
-    boxes: RobotBoxes,
-    union: Aabb,
-    bound: BoundGradient,
+    boxes: [RobotBox; SLOTS],
+    pull: [[Vector3<f32>; CORNERS]; SLOTS],
     touched: bool,
 }
 
 impl Waypoint {
-    fn new(k: Kinematics<f32>, held: Option<&[Vector3<f32>; CORNERS]>) -> Self {
-        let boxes = robot_boxes(&k, held);
-        let mut union: Option<Aabb> = None;
-        for (b, _) in boxes.aabb.iter().zip(boxes.active.iter()).filter(|(_, a)| **a) {
-            union = Some(union.map_or(*b, |u| u.union(b)));
+    fn new(k: Kinematics<f32>, held: Option<(&Pose<f32>, Vector3<f32>)>) -> Self {
+        let mut boxes = [IDLE; SLOTS];
+        for (b, slot) in boxes.iter_mut().enumerate().take(BODIES) {
+            // Bodies on the fixed root (link0) never move and are not checked against obstacles.
+            if PANDA.bodies[b].frame != 0 {
+                *slot = RobotBox::new(k.boxes[b], PANDA.bodies[b].half_extents);
+            }
+        }
+        if let Some((local, half)) = held {
+            let hand = &k.frames[HAND_FRAME];
+            let pose = Pose {
+                rotation: hand.rotation * local.rotation,
+                translation: hand.transform_point(&local.translation),
+            };
+            boxes[HELD] = RobotBox::new(pose, half);
         }
         Self {
             k,
             boxes,
-            union: union.unwrap_or(EMPTY),
-            bound: ZERO_BOUNDS,
+            pull: [[Vector3::zeros(); CORNERS]; SLOTS],
             touched: false,
+        }
+    }
+
+    /// Adds the gradient on one bound (axis `k` of the obstacle's frame) to the corner that set it.
+    fn pull_bound(&mut self, slot: usize, corner: u8, o: &ObstacleBox, k: usize, g: f32) {
+        self.touched = true;
+        if g != 0.0 {
+            self.pull[slot][usize::from(corner) % CORNERS] += o.axis(k) * g;
         }
     }
 }
@@ -204,33 +258,45 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
             return Err(Error::NonFiniteJoint { joint: joint as u8 });
         }
     }
-    let mut obstacles = [EMPTY; N];
+    let mut obstacles = [ObstacleBox {
+        axes: None,
+        origin: Vector3::zeros(),
+        bounds: Aabb {
+            min: Vector3::zeros(),
+            max: Vector3::zeros(),
+        },
+        center: Vector3::zeros(),
+        radius: 0.0,
+    }; N];
     for (slot, o) in obstacles.iter_mut().zip(scene.obstacles()) {
-        *slot = obstacle_aabb(o, &config.inflation, config.cylinder);
+        *slot = ObstacleBox::new(o, config);
         // Finite but huge sizes or inflation can overflow the box (and 0·∞ make it NaN).
-        if !(slot.min.iter().chain(slot.max.iter()).all(|x| x.is_finite())) {
+        if !slot.is_finite() {
             return Err(Error::Overflow);
         }
     }
     let obstacles = &obstacles[..scene.obstacles().len()];
-    let held = scene.held().map(|h| held_local_corners(h, config.cylinder));
+    let held = scene
+        .held()
+        .map(|h| (held_local_pose(h), box_dims(&h.shape, config.cylinder) * 0.5));
+    let held = held.as_ref().map(|(pose, half)| (pose, *half));
 
     let mut gradient = gradient;
     let mut total = 0.0f32;
     let mut previous: Option<Waypoint> = None;
     for (w, q) in trajectory.iter().enumerate() {
-        let mut current = Waypoint::new(forward(q)?, held.as_ref());
+        let mut current = Waypoint::new(forward(q)?, held);
         match (config.kind, previous.as_mut()) {
             (CostKind::Intersection, _) if w > 0 && w + 1 < H => total += intersection(&mut current, obstacles),
             (CostKind::Swept, Some(before)) => total += swept(before, &mut current, obstacles),
             _ => {}
         }
         if let Some(done) = previous.replace(current) {
-            finish(&done, w - 1, gradient.as_deref_mut(), held.as_ref())?;
+            finish(&done, w - 1, gradient.as_deref_mut())?;
         }
     }
     if let Some(done) = previous {
-        finish(&done, H - 1, gradient, held.as_ref())?;
+        finish(&done, H - 1, gradient)?;
     }
     if total.is_finite() {
         Ok(total)
@@ -239,19 +305,14 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     }
 }
 
-/// Writes waypoint `w`'s joint gradient once its bounds are final.
-fn finish<const H: usize>(
-    done: &Waypoint,
-    w: usize,
-    gradient: Option<&mut [Joints<f32>; H]>,
-    held: Option<&[Vector3<f32>; CORNERS]>,
-) -> Result<(), Error> {
+/// Writes waypoint `w`'s joint gradient once its corners' gradients are final.
+fn finish<const H: usize>(done: &Waypoint, w: usize, gradient: Option<&mut [Joints<f32>; H]>) -> Result<(), Error> {
     let Some(slot) = gradient.and_then(|g| g.get_mut(w)) else {
         return Ok(());
     };
     *slot = if done.touched {
         // Finite inputs whose volumes' gradients overflowed are an overflow, not bad input.
-        waypoint_gradient(done, held).map_err(|e| match e {
+        waypoint_gradient(done).map_err(|e| match e {
             Error::NonFiniteGradient => Error::Overflow,
             other => other,
         })?
@@ -261,25 +322,22 @@ fn finish<const H: usize>(
     Ok(())
 }
 
-/// Whether two boxes overlap with positive volume.
-fn overlaps(a: &Aabb, b: &Aabb) -> bool {
-    let (lo, hi) = (a.min.sup(&b.min), a.max.inf(&b.max));
-    hi.x > lo.x && hi.y > lo.y && hi.z > lo.z
-}
-
 /// Intersection volume of one interior waypoint's boxes; adds its gradient to the waypoint.
-fn intersection(w: &mut Waypoint, obstacles: &[Aabb]) -> f32 {
+fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     let mut total = 0.0;
-    for o in obstacles.iter().filter(|o| overlaps(&w.union, o)) {
+    for o in obstacles {
         for s in 0..SLOTS {
-            if !w.boxes.active[s] {
+            let b = w.boxes[s];
+            if !b.active || !b.near(o) {
                 continue;
             }
-            if let Some((v, d_min, d_max)) = volume_with_gradient(&w.boxes.aabb[s], o) {
+            let (aabb, arg) = b.aabb_in(o);
+            if let Some((v, d_min, d_max)) = volume_with_gradient(&aabb, &o.bounds) {
                 total += v;
-                w.bound[s][0] += d_min;
-                w.bound[s][1] += d_max;
-                w.touched = true;
+                for k in 0..3 {
+                    w.pull_bound(s, arg[0][k], o, k, d_min[k]);
+                    w.pull_bound(s, arg[1][k], o, k, d_max[k]);
+                }
             }
         }
     }
@@ -288,24 +346,35 @@ fn intersection(w: &mut Waypoint, obstacles: &[Aabb]) -> f32 {
 
 /// Swept volume of the segment between two waypoints; each swept bound's share of the
 /// gradient goes to the end that set it (ties to the first end).
-fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[Aabb]) -> f32 {
+fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     let mut total = 0.0;
-    let union = a.union.union(&b.union);
-    for o in obstacles.iter().filter(|o| overlaps(&union, o)) {
+    for o in obstacles {
         for s in 0..SLOTS {
-            if !a.boxes.active[s] {
+            let (box_a, box_b) = (a.boxes[s], b.boxes[s]);
+            if !box_a.active {
                 continue;
             }
-            let (box_a, box_b) = (a.boxes.aabb[s], b.boxes.aabb[s]);
-            if let Some((v, d_min, d_max)) = volume_with_gradient(&box_a.union(&box_b), o) {
+            // The union of the two ends' boxes lies in a ball around the midpoint.
+            let half_span = 0.5 * libm::sqrtf((box_a.pose.translation - box_b.pose.translation).norm_squared());
+            let r = half_span + box_a.reach.max(box_b.reach) + o.radius;
+            let mid = (box_a.pose.translation + box_b.pose.translation) * 0.5;
+            if (mid - o.center).norm_squared() > r * r {
+                continue;
+            }
+            let ((la, arg_a), (lb, arg_b)) = (box_a.aabb_in(o), box_b.aabb_in(o));
+            if let Some((v, d_min, d_max)) = volume_with_gradient(&la.union(&lb), &o.bounds) {
                 total += v;
                 for k in 0..3 {
-                    let min_end = if box_b.min[k] < box_a.min[k] { &mut *b } else { &mut *a };
-                    min_end.bound[s][0][k] += d_min[k];
-                    min_end.touched = true;
-                    let max_end = if box_b.max[k] > box_a.max[k] { &mut *b } else { &mut *a };
-                    max_end.bound[s][1][k] += d_max[k];
-                    max_end.touched = true;
+                    if lb.min[k] < la.min[k] {
+                        b.pull_bound(s, arg_b[0][k], o, k, d_min[k]);
+                    } else {
+                        a.pull_bound(s, arg_a[0][k], o, k, d_min[k]);
+                    }
+                    if lb.max[k] > la.max[k] {
+                        b.pull_bound(s, arg_b[1][k], o, k, d_max[k]);
+                    } else {
+                        a.pull_bound(s, arg_a[1][k], o, k, d_max[k]);
+                    }
                 }
             }
         }
@@ -313,26 +382,19 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[Aabb]) -> f32 {
     total
 }
 
-/// Joint gradient of one waypoint from the gradient on its boxes' bounds: each bound's share
-/// pulls on the corner that set it, a point moving with the body's frame (the held object's
-/// with the hand), and the FK adjoint takes it to the joints.
-fn waypoint_gradient(w: &Waypoint, held: Option<&[Vector3<f32>; CORNERS]>) -> Result<Joints<f32>, Error> {
+/// Joint gradient of one waypoint from the gradient on its boxes' corners: each corner is a
+/// point moving with its body's frame (the held object's with the hand), and the FK adjoint
+/// takes it to the joints.
+fn waypoint_gradient(w: &Waypoint) -> Result<Joints<f32>, Error> {
     let mut cot = Cotangent::new();
-    for (s, (sides, args)) in w.bound.iter().zip(w.boxes.arg.iter()).enumerate() {
-        for (side, arg) in sides.iter().zip(args.iter()) {
-            for (axis, (&g, &corner)) in side.iter().zip(arg.iter()).enumerate() {
-                if g == 0.0 {
-                    continue;
-                }
-                let corner = usize::from(corner) % CORNERS;
-                let (frame, point) = match (PANDA.bodies.get(s), held) {
-                    (Some(body), _) => (body.frame, box_corner(&w.k.boxes[s], &body.half_extents, corner)),
-                    (None, Some(local)) => (HAND_FRAME, w.k.frames[HAND_FRAME].transform_point(&local[corner])),
-                    (None, None) => continue,
-                };
-                let mut pull = Vector3::zeros();
-                pull[axis] = g;
-                cot.add_point(frame, &point, &pull);
+    for (s, (pulls, b)) in w.pull.iter().zip(w.boxes.iter()).enumerate() {
+        if !b.active {
+            continue;
+        }
+        let frame = PANDA.bodies.get(s).map_or(HAND_FRAME, |body| body.frame);
+        for (corner, g) in pulls.iter().enumerate() {
+            if *g != Vector3::zeros() {
+                cot.add_point(frame, &box_corner(&b.pose, &b.half, corner), g);
             }
         }
     }
@@ -352,6 +414,7 @@ mod tests {
             kind,
             inflation: Inflation::default(),
             cylinder: CylinderBox::Enclosing,
+            frame: BoxFrame::Obstacle,
         }
     }
 

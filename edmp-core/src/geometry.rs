@@ -44,6 +44,18 @@ pub enum CylinderBox {
     OriginalEdmp,
 }
 
+/// The frame in which each obstacle and robot box pair is boxed for the costs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BoxFrame {
+    /// The obstacle's own frame: its box is exact there, and the robot's box is boxed along
+    /// the obstacle's axes. A thin board keeps its thickness whatever its yaw.
+    #[default]
+    Obstacle,
+    /// The world axes, as the original EDMP code: every obstacle becomes its world AABB, so a
+    /// 1.3 m shelf board yawed by 6° is costed as 15 cm thick.
+    World,
+}
+
 /// Growth of obstacles for a guide at one diffusion step (metres, full extents).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Inflation {
@@ -65,10 +77,15 @@ pub fn box_dims(shape: &Shape, cylinder: CylinderBox) -> Vector3<f32> {
     }
 }
 
-/// World AABB of an obstacle's box after inflation: `dims_eff = max(dims, e) + c`, rotated,
-/// then boxed (the 8-corner AABB, computed exactly as `|R| · dims_eff / 2`).
+/// Full extents of an obstacle's box after inflation: `max(dims, e) + c`.
+pub fn inflated_dims(obstacle: &Obstacle, inflation: &Inflation, cylinder: CylinderBox) -> Vector3<f32> {
+    box_dims(&obstacle.shape, cylinder).map(|d| d.max(inflation.expansion) + inflation.clearance)
+}
+
+/// World AABB of an obstacle's box after inflation ([`inflated_dims`]), rotated, then boxed
+/// (the 8-corner AABB, computed exactly as `|R| · dims_eff / 2`).
 pub fn obstacle_aabb(obstacle: &Obstacle, inflation: &Inflation, cylinder: CylinderBox) -> Aabb {
-    let dims = box_dims(&obstacle.shape, cylinder).map(|d| d.max(inflation.expansion) + inflation.clearance);
+    let dims = inflated_dims(obstacle, inflation, cylinder);
     let half = obstacle.rotation.abs() * dims * 0.5;
     Aabb {
         min: obstacle.center - half,

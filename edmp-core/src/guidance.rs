@@ -10,7 +10,7 @@
 
 use crate::cost::{CostConfig, trajectory_cost};
 use crate::error::Error;
-use crate::geometry::CylinderBox;
+use crate::geometry::{BoxFrame, CylinderBox};
 use crate::guides::Guide;
 use crate::kinematics::Joints;
 use crate::robot::PANDA;
@@ -18,9 +18,11 @@ use crate::scene::Scene;
 
 /// Applies every row's guide once at diffusion step `t`, no joint of a waypoint moving more
 /// than `step_limit` radians (`f32::INFINITY`: the original's unlimited step). `grads` is
-/// working memory, one entry per row. Fails with [`Error::BadParameter`] if the rows do not split evenly over the guides or
+/// working memory, one entry per row. `cylinder` and `frame` choose how the costs box
+/// things ([`CostConfig`]). Fails with [`Error::BadParameter`] if the rows do not split evenly over the guides or
 /// `grads` has another length; non-finite joints and overflowing results are typed errors too,
 /// and then `rows` may be partly updated.
+#[allow(clippy::too_many_arguments)]
 pub fn guide_step<const H: usize, const N: usize>(
     scene: &Scene<N>,
     rows: &mut [[Joints<f32>; H]],
@@ -29,6 +31,7 @@ pub fn guide_step<const H: usize, const N: usize>(
     t: u16,
     step_limit: f32,
     cylinder: CylinderBox,
+    frame: BoxFrame,
 ) -> Result<(), Error> {
     if step_limit.is_nan() || step_limit <= 0.0 {
         return Err(Error::BadParameter);
@@ -49,6 +52,7 @@ pub fn guide_step<const H: usize, const N: usize>(
             kind: guide.cost,
             inflation: guide.inflation(t),
             cylinder,
+            frame,
         };
         let mut norm2 = 0.0f32;
         for (row, grad) in rows.iter().zip(grads.iter_mut()) {
@@ -109,6 +113,7 @@ mod tests {
             kind: guide.cost,
             inflation: guide.inflation(t),
             cylinder: CylinderBox::Enclosing,
+            frame: BoxFrame::Obstacle,
         };
         trajectory_cost(scene, x, &config, None).unwrap()
     }
@@ -137,6 +142,7 @@ mod tests {
                 t,
                 f32::INFINITY,
                 CylinderBox::Enclosing,
+                BoxFrame::Obstacle,
             )
             .unwrap();
             let after = cost(&scene, &rows[0], guide, t);
@@ -162,6 +168,7 @@ mod tests {
             100,
             f32::INFINITY,
             CylinderBox::Enclosing,
+            BoxFrame::Obstacle,
         )
         .unwrap();
         assert_eq!(rows, before);
@@ -199,6 +206,7 @@ mod tests {
             50,
             f32::INFINITY,
             CylinderBox::Enclosing,
+            BoxFrame::Obstacle,
         )
         .unwrap();
         guide_step(
@@ -209,6 +217,7 @@ mod tests {
             50,
             f32::INFINITY,
             CylinderBox::Enclosing,
+            BoxFrame::Obstacle,
         )
         .unwrap();
         assert_eq!(g1, g2);
@@ -232,6 +241,7 @@ mod tests {
             10,
             f32::INFINITY,
             CylinderBox::Enclosing,
+            BoxFrame::Obstacle,
         );
         assert_eq!(err, Err(Error::BadParameter));
         let mut short = [[[0.0f32; 7]; H]; 11];
@@ -244,6 +254,7 @@ mod tests {
             10,
             f32::INFINITY,
             CylinderBox::Enclosing,
+            BoxFrame::Obstacle,
         );
         assert_eq!(err, Err(Error::BadParameter));
     }
@@ -265,6 +276,7 @@ mod tests {
             200,
             f32::INFINITY,
             CylinderBox::Enclosing,
+            BoxFrame::Obstacle,
         )
         .unwrap();
         let moved = |rows: &[[Joints<f32>; H]; 1]| {
@@ -285,6 +297,7 @@ mod tests {
             200,
             0.02,
             CylinderBox::Enclosing,
+            BoxFrame::Obstacle,
         )
         .unwrap();
         assert!(moved(&limited) <= 0.02 + 1e-6, "{}", moved(&limited));
@@ -298,6 +311,7 @@ mod tests {
                 200,
                 bad,
                 CylinderBox::Enclosing,
+                BoxFrame::Obstacle,
             );
             assert_eq!(err, Err(Error::BadParameter));
         }

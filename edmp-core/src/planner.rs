@@ -9,7 +9,7 @@
 use crate::checker::{CheckConfig, check_trajectory};
 use crate::cost::{CostConfig, CostKind, trajectory_cost};
 use crate::error::Error;
-use crate::geometry::{CylinderBox, Inflation};
+use crate::geometry::{BoxFrame, CylinderBox, Inflation};
 use crate::guidance::guide_step;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
@@ -65,6 +65,9 @@ pub struct PlanConfig {
     pub step_limit: f32,
     /// How cylinders are boxed for the costs.
     pub cylinder: CylinderBox,
+    /// The frame the costs box each obstacle and robot box pair in (a deviation from the
+    /// original's world AABBs, measured in the README).
+    pub frame: BoxFrame,
     /// The exact checker's settings for the final judgement.
     pub check: CheckConfig,
 }
@@ -120,6 +123,7 @@ impl PlanConfig {
         refine: DEFAULT_REFINE_STEPS,
         step_limit: DEFAULT_STEP_LIMIT,
         cylinder: CylinderBox::Enclosing,
+        frame: BoxFrame::Obstacle,
         check: CheckConfig::DEFAULT,
     };
 }
@@ -241,6 +245,7 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
                 step.t,
                 config.step_limit,
                 config.cylinder,
+                config.frame,
             )?;
         }
     }
@@ -253,6 +258,7 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
             1,
             config.step_limit,
             config.cylinder,
+            config.frame,
         )?;
     }
     Ok(())
@@ -278,6 +284,7 @@ pub fn select<const B: usize, const N: usize>(
         kind: CostKind::Swept,
         inflation: Inflation::default(),
         cylinder: config.cylinder,
+        frame: config.frame,
     };
     let mut verdicts = [Verdict {
         swept: 0.0,
@@ -342,6 +349,7 @@ mod tests {
             refine: 0,
             step_limit: f32::INFINITY,
             cylinder: CylinderBox::Enclosing,
+            frame: BoxFrame::Obstacle,
             check: CheckConfig::default(),
         }
     }

@@ -6,7 +6,7 @@
 use crate::Failure;
 use crate::json::{Problem, joint_goal, parse_problem};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
-use edmp_core::geometry::Inflation;
+use edmp_core::geometry::{BoxFrame, Inflation};
 use edmp_core::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
@@ -58,6 +58,10 @@ pub(crate) struct Tuning {
     /// unlimited step).
     #[arg(long, default_value_t = DEFAULT_STEP_LIMIT)]
     step_limit: f32,
+    /// Cost every obstacle as its world AABB, as the original EDMP code (default: each
+    /// obstacle and robot box pair in the obstacle's frame).
+    #[arg(long)]
+    world_boxes: bool,
     /// EDMP's original sampler and guidance: 255 ancestral steps, guidance on even t ≥ 6.
     #[arg(long)]
     ancestral: bool,
@@ -81,6 +85,11 @@ impl Tuning {
             },
             refine: self.refine_steps,
             step_limit: self.step_limit,
+            frame: if self.world_boxes {
+                BoxFrame::World
+            } else {
+                BoxFrame::Obstacle
+            },
             ..PlanConfig::DEFAULT
         };
         if self.step_limit.is_nan() || self.step_limit <= 0.0 {
@@ -101,6 +110,7 @@ impl Tuning {
 
     /// A short label for tables.
     pub(crate) fn label(&self) -> String {
+        let boxes = if self.world_boxes { ", world AABBs" } else { "" };
         let limit = if self.step_limit.is_finite() {
             format!("step limit {} rad", self.step_limit)
         } else {
@@ -108,12 +118,12 @@ impl Tuning {
         };
         if self.ancestral {
             format!(
-                "ancestral K = 255, guidance on even t, {} refinement steps, {limit}",
+                "ancestral K = 255, guidance on even t, {} refinement steps, {limit}{boxes}",
                 self.refine_steps
             )
         } else {
             format!(
-                "strided K = {}, {} gradient steps per step, {} refinement steps, {limit}",
+                "strided K = {}, {} gradient steps per step, {} refinement steps, {limit}{boxes}",
                 self.steps, self.gradient_steps, self.refine_steps
             )
         }
@@ -208,6 +218,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         kind: CostKind::Intersection,
         inflation: Inflation::default(),
         cylinder: config.cylinder,
+        frame: config.frame,
     };
     let intersection = trajectory_cost(&problem.scene, best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
     let per_guide = ROWS / guides.len();

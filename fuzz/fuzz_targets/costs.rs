@@ -6,7 +6,7 @@
 use edmp_core::Error;
 use edmp_core::checker::{CheckConfig, check_state, check_trajectory};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
-use edmp_core::geometry::{CylinderBox, Inflation};
+use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
 use edmp_core::scene::{Obstacle, Scene, SceneError};
 use libfuzzer_sys::fuzz_target;
 
@@ -68,7 +68,8 @@ fuzz_target!(|data: &[u8]| {
     let trajectory: [[f32; 7]; H] = core::array::from_fn(|_| r.array::<7>());
     let kind = if flags & 1 == 0 { CostKind::Intersection } else { CostKind::Swept };
     let cylinder = if flags & 2 == 0 { CylinderBox::Enclosing } else { CylinderBox::OriginalEdmp };
-    let config = CostConfig { kind, inflation, cylinder };
+    let frame = if flags & 16 == 0 { BoxFrame::Obstacle } else { BoxFrame::World };
+    let config = CostConfig { kind, inflation, cylinder, frame };
 
     let joints_finite = trajectory.iter().flatten().all(|x| x.is_finite());
     let params_ok = inflation.clearance.is_finite()

@@ -9,7 +9,7 @@
 //! by less than 1e-5 m (below what f32 resolves reliably) are discarded as near a kink.
 
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
-use edmp_core::geometry::{CylinderBox, Inflation};
+use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
 use edmp_core::kinematics::forward;
 use edmp_core::robot::{BODIES, JOINTS, PANDA};
 use edmp_core::scene::{Obstacle, Scene};
@@ -27,7 +27,13 @@ struct Case {
 
 fn case() -> impl Strategy<Value = Case> {
     let joint = |j: usize| PANDA.soft_lower[j]..PANDA.soft_upper[j];
-    let config = (0..2u8, 0.0f32..0.1, prop_oneof![Just(0.0f32), 0.0f32..0.4], 0..2u8);
+    let config = (
+        0..2u8,
+        0.0f32..0.1,
+        prop_oneof![Just(0.0f32), 0.0f32..0.4],
+        0..2u8,
+        0..2u8,
+    );
     let obstacle = (
         0..3u8,
         0..BODIES,
@@ -45,7 +51,7 @@ fn case() -> impl Strategy<Value = Case> {
         config,
     )
         .prop_map(
-            move |(a, b, noise, obstacles, held, (kind, clearance, expansion, cyl))| {
+            move |(a, b, noise, obstacles, held, (kind, clearance, expansion, cyl, frame))| {
                 let lerp = |t: f32, j: usize| {
                     let r = joint(j);
                     let x = r.start + (a[j] + (b[j] - a[j]) * t) * (r.end - r.start);
@@ -94,6 +100,11 @@ fn case() -> impl Strategy<Value = Case> {
                         kind,
                         inflation: Inflation { clearance, expansion },
                         cylinder,
+                        frame: if frame == 0 {
+                            BoxFrame::Obstacle
+                        } else {
+                            BoxFrame::World
+                        },
                     },
                 }
             },
@@ -199,6 +210,7 @@ fn original_cylinder_boxing_under_covers() {
         kind: CostKind::Intersection,
         inflation: Inflation::default(),
         cylinder,
+        frame: BoxFrame::World,
     };
     let enclosing = trajectory_cost(&scene, &[q; 3], &cfg(CylinderBox::Enclosing), None).unwrap();
     let original = trajectory_cost(&scene, &[q; 3], &cfg(CylinderBox::OriginalEdmp), None).unwrap();
