@@ -60,9 +60,8 @@ struct ObstacleBox {
     origin: Vector3<f32>,
     /// The box in that frame.
     bounds: Aabb,
-    /// World centre and radius of a ball holding the box.
-    center: Vector3<f32>,
-    radius: f32,
+    /// The box's world AABB (broad phase).
+    world: Aabb,
 }
 
 impl ObstacleBox {
@@ -74,8 +73,7 @@ impl ObstacleBox {
                     axes: None,
                     origin: Vector3::zeros(),
                     bounds,
-                    center: (bounds.min + bounds.max) * 0.5,
-                    radius: (bounds.max - bounds.min).norm() * 0.5,
+                    world: bounds,
                 }
             }
             BoxFrame::Obstacle => {
@@ -84,18 +82,30 @@ impl ObstacleBox {
                     axes: Some(o.rotation),
                     origin: o.center,
                     bounds: Aabb { min: -half, max: half },
-                    center: o.center,
-                    radius: half.norm(),
+                    world: obstacle_aabb(o, &config.inflation, config.cylinder),
                 }
             }
         }
     }
 
     fn is_finite(&self) -> bool {
-        let v = [self.bounds.min, self.bounds.max, self.origin, self.center];
+        let v = [self.bounds.min, self.bounds.max, self.origin, self.world.min, self.world.max];
         v.iter().flat_map(|x| x.iter()).all(|x| x.is_finite())
-            && self.radius.is_finite()
             && self.axes.is_none_or(|a| a.iter().all(|x| x.is_finite()))
+    }
+
+    /// A world point in the frame.
+    fn local(&self, p: &Vector3<f32>) -> Vector3<f32> {
+        match &self.axes {
+            Some(a) => a.transpose() * (p - self.origin),
+            None => *p,
+        }
+    }
+
+    /// Whether a robot box centred at `c` (in the frame) with `|half| = radius` may reach the
+    /// box along axis `k`: its AABB's half extent on any axis is at most `radius`.
+    fn apart_on(&self, c: &Vector3<f32>, radius: f32, k: usize) -> bool {
+        c[k] - radius > self.bounds.max[k] || c[k] + radius < self.bounds.min[k]
     }
 
     /// World direction of the frame's axis `k`.
@@ -112,9 +122,8 @@ impl ObstacleBox {
 struct RobotBox {
     pose: Pose<f32>,
     half: Vector3<f32>,
-    /// Radius of a ball around the centre that holds the box's AABB in any frame
-    /// (`√3·|half|`: each AABB half extent is at most `|half|`).
-    reach: f32,
+    /// `|half|`: the box's AABB in any frame has half extents of at most this.
+    radius: f32,
     active: bool,
 }
 
@@ -124,7 +133,7 @@ const IDLE: RobotBox = RobotBox {
         translation: Vector3::new(0.0, 0.0, 0.0),
     },
     half: Vector3::new(0.0, 0.0, 0.0),
-    reach: 0.0,
+    radius: 0.0,
     active: false,
 };
 
@@ -133,26 +142,18 @@ impl RobotBox {
         Self {
             pose,
             half,
-            reach: 1.732_051 * half.norm(),
+            radius: libm::sqrtf(half.norm_squared()),
             active: true,
         }
     }
 
-    /// Whether the ball around the box can touch the obstacle's ball.
-    fn near(&self, o: &ObstacleBox) -> bool {
-        let r = self.reach + o.radius;
-        (self.pose.translation - o.center).norm_squared() <= r * r
-    }
-
-    /// The box's AABB in the obstacle's frame, with the corners that set its bounds: along
-    /// axis `k` the highest corner takes `+half_j` exactly where `M[k][j] > 0`.
-    fn aabb_in(&self, o: &ObstacleBox) -> (Aabb, [[u8; 3]; 2]) {
-        let (r, c) = match &o.axes {
-            Some(a) => (
-                a.transpose() * self.pose.rotation,
-                a.transpose() * (self.pose.translation - o.origin),
-            ),
-            None => (self.pose.rotation, self.pose.translation),
+    /// The box's AABB in the obstacle's frame given its centre `c` there, with the corners
+    /// that set its bounds: along axis `k` the highest corner takes `+half_j` exactly where
+    /// `M[k][j] > 0`.
+    fn aabb_in(&self, o: &ObstacleBox, c: Vector3<f32>) -> (Aabb, [[u8; 3]; 2]) {
+        let r = match &o.axes {
+            Some(a) => a.transpose() * self.pose.rotation,
+            None => self.pose.rotation,
         };
         let reach = r.abs() * self.half;
         let mut arg = [[0u8; 3]; 2];
@@ -198,6 +199,9 @@ fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector
 struct Waypoint {
     k: Kinematics<f32>,
     boxes: [RobotBox; SLOTS],
+    /// Per box, a world AABB holding its AABB in any frame, and their union (broad phase).
+    balls: [Aabb; SLOTS],
+    hull: Aabb,
     pull: [[Vector3<f32>; CORNERS]; SLOTS],
     touched: bool,
 }
@@ -219,9 +223,29 @@ impl Waypoint {
             };
             boxes[HELD] = RobotBox::new(pose, half);
         }
+        let mut hull: Option<Aabb> = None;
+        let mut balls = [Aabb {
+            min: Vector3::zeros(),
+            max: Vector3::zeros(),
+        }; SLOTS];
+        for (b, ball) in boxes.iter().zip(balls.iter_mut()).filter(|(b, _)| b.active) {
+            // Each AABB of the box lies in a cube of half side `radius` in its frame, so in a
+            // ball of radius √3·radius.
+            let r = Vector3::repeat(1.732_051 * b.radius);
+            *ball = Aabb {
+                min: b.pose.translation - r,
+                max: b.pose.translation + r,
+            };
+            hull = Some(hull.map_or(*ball, |h| h.union(ball)));
+        }
         Self {
             k,
             boxes,
+            balls,
+            hull: hull.unwrap_or(Aabb {
+                min: Vector3::zeros(),
+                max: Vector3::zeros(),
+            }),
             pull: [[Vector3::zeros(); CORNERS]; SLOTS],
             touched: false,
         }
@@ -258,15 +282,15 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
             return Err(Error::NonFiniteJoint { joint: joint as u8 });
         }
     }
+    let empty = Aabb {
+        min: Vector3::zeros(),
+        max: Vector3::zeros(),
+    };
     let mut obstacles = [ObstacleBox {
         axes: None,
         origin: Vector3::zeros(),
-        bounds: Aabb {
-            min: Vector3::zeros(),
-            max: Vector3::zeros(),
-        },
-        center: Vector3::zeros(),
-        radius: 0.0,
+        bounds: empty,
+        world: empty,
     }; N];
     for (slot, o) in obstacles.iter_mut().zip(scene.obstacles()) {
         *slot = ObstacleBox::new(o, config);
@@ -322,16 +346,27 @@ fn finish<const H: usize>(done: &Waypoint, w: usize, gradient: Option<&mut [Join
     Ok(())
 }
 
+/// Whether two boxes overlap with positive volume.
+fn overlaps(a: &Aabb, b: &Aabb) -> bool {
+    let (lo, hi) = (a.min.sup(&b.min), a.max.inf(&b.max));
+    hi.x > lo.x && hi.y > lo.y && hi.z > lo.z
+}
+
 /// Intersection volume of one interior waypoint's boxes; adds its gradient to the waypoint.
 fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     let mut total = 0.0;
-    for o in obstacles {
+    let hull = w.hull;
+    for o in obstacles.iter().filter(|o| overlaps(&hull, &o.world)) {
         for s in 0..SLOTS {
             let b = w.boxes[s];
-            if !b.active || !b.near(o) {
+            if !b.active || !overlaps(&w.balls[s], &o.world) {
                 continue;
             }
-            let (aabb, arg) = b.aabb_in(o);
+            let c = o.local(&b.pose.translation);
+            if (0..3).any(|k| o.apart_on(&c, b.radius, k)) {
+                continue;
+            }
+            let (aabb, arg) = b.aabb_in(o, c);
             if let Some((v, d_min, d_max)) = volume_with_gradient(&aabb, &o.bounds) {
                 total += v;
                 for k in 0..3 {
@@ -348,20 +383,46 @@ fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
 /// gradient goes to the end that set it (ties to the first end).
 fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     let mut total = 0.0;
-    for o in obstacles {
-        for s in 0..SLOTS {
+    // In an obstacle's frame the union of the two ends' AABBs lies in a ball around the
+    // midpoint of radius |ca − cb| / 2 + √3·|half| (not in the world-axis union of the ends'
+    // balls: the frame may be turned).
+    let mut reach = [Aabb {
+        min: Vector3::zeros(),
+        max: Vector3::zeros(),
+    }; SLOTS];
+    let mut hull: Option<Aabb> = None;
+    for ((ba, bb), r) in a.boxes.iter().zip(b.boxes.iter()).zip(reach.iter_mut()) {
+        if !ba.active {
+            continue;
+        }
+        let (pa, pb) = (ba.pose.translation, bb.pose.translation);
+        let radius = 0.5 * libm::sqrtf((pa - pb).norm_squared()) + 1.732_051 * ba.radius.max(bb.radius);
+        let mid = (pa + pb) * 0.5;
+        *r = Aabb {
+            min: mid - Vector3::repeat(radius),
+            max: mid + Vector3::repeat(radius),
+        };
+        hull = Some(hull.map_or(*r, |h| h.union(r)));
+    }
+    let Some(hull) = hull else {
+        return 0.0;
+    };
+    for o in obstacles.iter().filter(|o| overlaps(&hull, &o.world)) {
+        for (s, r) in reach.iter().enumerate() {
             let (box_a, box_b) = (a.boxes[s], b.boxes[s]);
-            if !box_a.active {
+            if !box_a.active || !overlaps(r, &o.world) {
                 continue;
             }
-            // The union of the two ends' boxes lies in a ball around the midpoint.
-            let half_span = 0.5 * libm::sqrtf((box_a.pose.translation - box_b.pose.translation).norm_squared());
-            let r = half_span + box_a.reach.max(box_b.reach) + o.radius;
-            let mid = (box_a.pose.translation + box_b.pose.translation) * 0.5;
-            if (mid - o.center).norm_squared() > r * r {
+            let (ca, cb) = (o.local(&box_a.pose.translation), o.local(&box_b.pose.translation));
+            // Both ends' AABBs beyond the box on the same side of one axis: the union is too.
+            if (0..3).any(|k| {
+                let (ra, rb) = (box_a.radius, box_b.radius);
+                (ca[k] - ra > o.bounds.max[k] && cb[k] - rb > o.bounds.max[k])
+                    || (ca[k] + ra < o.bounds.min[k] && cb[k] + rb < o.bounds.min[k])
+            }) {
                 continue;
             }
-            let ((la, arg_a), (lb, arg_b)) = (box_a.aabb_in(o), box_b.aabb_in(o));
+            let ((la, arg_a), (lb, arg_b)) = (box_a.aabb_in(o, ca), box_b.aabb_in(o, cb));
             if let Some((v, d_min, d_max)) = volume_with_gradient(&la.union(&lb), &o.bounds) {
                 total += v;
                 for k in 0..3 {
