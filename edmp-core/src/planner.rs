@@ -103,13 +103,13 @@ pub struct Plan<const B: usize> {
 pub const DEFAULT_STEPS: u16 = 5;
 
 /// Gradient steps per denoising step of the shipped configuration.
-pub const DEFAULT_GRADIENT_STEPS: u8 = 8;
+pub const DEFAULT_GRADIENT_STEPS: u8 = 4;
 
 /// Per-joint limit of one gradient step in the shipped configuration, radians.
 pub const DEFAULT_STEP_LIMIT: f32 = 0.1;
 
 /// Refinement gradient steps after the last denoising step in the shipped configuration.
-pub const DEFAULT_REFINE_STEPS: u8 = 16;
+pub const DEFAULT_REFINE_STEPS: u8 = 48;
 
 impl PlanConfig {
     /// The shipped configuration, picked from the suite measurements in the README: the
