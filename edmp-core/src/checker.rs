@@ -152,10 +152,13 @@ struct Placed<'a> {
 
 impl Placed<'_> {
     fn obb(&self, b: usize) -> Primitive {
+        // `% BODIES`: callers pass robot bodies only; the modulo keeps the index provably in range.
+        let b = b % BODIES;
         Primitive::cuboid(&self.k.boxes[b], &PANDA.bodies[b].half_extents)
     }
 
     fn hull(&self, b: usize) -> Hull<'_> {
+        let b = b % BODIES;
         Hull {
             pose: &self.k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
             points: PANDA.hull(b),
@@ -240,8 +243,10 @@ impl<'s, const N: usize> Prepared<'s, N> {
         let mut pair_count = 0;
         for a in 0..shapes {
             for b in a + 1..shapes {
-                if body_level(a).abs_diff(body_level(b)) >= 2 {
-                    pairs[pair_count] = (a as u8, b as u8);
+                if body_level(a).abs_diff(body_level(b)) >= 2
+                    && let Some(slot) = pairs.get_mut(pair_count)
+                {
+                    *slot = (a as u8, b as u8);
                     pair_count += 1;
                 }
             }
@@ -280,9 +285,10 @@ impl<'s, const N: usize> Prepared<'s, N> {
                 .obstacles
                 .iter()
                 .zip(self.obstacle_radius.iter())
-                .zip(self.hints.obstacle[b].iter_mut());
+                .zip(self.hints.obstacle[b % SLOTS].iter_mut());
             for (i, ((o, &r), hint)) in candidates.take(count).enumerate() {
-                if near(&center[b], self.radius[b], &o.center, r) && !placed.body_apart_from(b, o, hint) {
+                if near(&center[b % SLOTS], self.radius[b % SLOTS], &o.center, r) && !placed.body_apart_from(b, o, hint)
+                {
                     return Ok(Some(Contact::Obstacle {
                         body: b as u8,
                         obstacle: i as u8,
@@ -293,8 +299,9 @@ impl<'s, const N: usize> Prepared<'s, N> {
         if !self.config.self_collision {
             return Ok(None);
         }
-        for &(a, b) in &self.pairs[..self.pair_count] {
-            let (a, b) = (usize::from(a), usize::from(b));
+        for &(a, b) in self.pairs.iter().take(self.pair_count) {
+            // `% SLOTS`: pairs hold shape indices below SLOTS; the modulo proves it to the compiler.
+            let (a, b) = (usize::from(a) % SLOTS, usize::from(b) % SLOTS);
             if near(&center[a], self.radius[a], &center[b], self.radius[b])
                 && !placed.bodies_apart(a, b, &mut self.hints.body[a][b])
             {

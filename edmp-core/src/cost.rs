@@ -89,7 +89,13 @@ impl ObstacleBox {
     }
 
     fn is_finite(&self) -> bool {
-        let v = [self.bounds.min, self.bounds.max, self.origin, self.world.min, self.world.max];
+        let v = [
+            self.bounds.min,
+            self.bounds.max,
+            self.origin,
+            self.world.min,
+            self.world.max,
+        ];
         v.iter().flat_map(|x| x.iter()).all(|x| x.is_finite())
             && self.axes.is_none_or(|a| a.iter().all(|x| x.is_finite()))
     }
@@ -110,9 +116,14 @@ impl ObstacleBox {
 
     /// World direction of the frame's axis `k`.
     fn axis(&self, k: usize) -> Vector3<f32> {
-        match &self.axes {
-            Some(a) => a.column(k).into_owned(),
-            None => Vector3::ith(k, 1.0),
+        // Constant column indices: no run-time bounds check (and no panic path) in nalgebra.
+        match (&self.axes, k) {
+            (Some(a), 0) => a.column(0).into_owned(),
+            (Some(a), 1) => a.column(1).into_owned(),
+            (Some(a), _) => a.column(2).into_owned(),
+            (None, 0) => Vector3::x(),
+            (None, 1) => Vector3::y(),
+            (None, _) => Vector3::z(),
         }
     }
 }
@@ -255,7 +266,7 @@ impl Waypoint {
     fn pull_bound(&mut self, slot: usize, corner: u8, o: &ObstacleBox, k: usize, g: f32) {
         self.touched = true;
         if g != 0.0 {
-            self.pull[slot][usize::from(corner) % CORNERS] += o.axis(k) * g;
+            self.pull[slot % SLOTS][usize::from(corner) % CORNERS] += o.axis(k) * g;
         }
     }
 }
@@ -299,7 +310,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
             return Err(Error::Overflow);
         }
     }
-    let obstacles = &obstacles[..scene.obstacles().len()];
+    let obstacles = obstacles.get(..scene.obstacles().len()).unwrap_or(&[]);
     let held = scene
         .held()
         .map(|h| (held_local_pose(h), box_dims(&h.shape, config.cylinder) * 0.5));
@@ -407,9 +418,10 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     let Some(hull) = hull else {
         return 0.0;
     };
+    let (boxes_a, boxes_b) = (a.boxes, b.boxes);
     for o in obstacles.iter().filter(|o| overlaps(&hull, &o.world)) {
-        for (s, r) in reach.iter().enumerate() {
-            let (box_a, box_b) = (a.boxes[s], b.boxes[s]);
+        let ends = boxes_a.iter().zip(boxes_b.iter());
+        for (s, ((box_a, box_b), r)) in ends.zip(reach.iter()).enumerate() {
             if !box_a.active || !overlaps(r, &o.world) {
                 continue;
             }

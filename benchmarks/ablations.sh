@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Every planner run behind docs/benchmark.md and the README's planner table, then the report.
+# Runs land in bench-out/<name>/ (results.jsonl, summary.md, charts); the report in
+# docs/benchmark/. About 25 minutes on the 2-core development machine.
+#   benchmarks/ablations.sh            # everything
+#   ONLY="edmp rrt" benchmarks/ablations.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -p edmp-host
+B=target/release/edmp-host
+OUT=${OUT:-bench-out}
+want() { [ -z "${ONLY:-}" ] || [[ " $ONLY " == *" $1 "* ]]; }
+run() {
+    local name=$1
+    shift
+    if want "$name"; then
+        echo "== $name: $*"
+        "$B" bench -o "$OUT/$name" "$@" | tail -1
+    fi
+}
+
+# Timings: one plan at a time on one core.
+run edmp --serial
+run rrt --planner rrt-connect --serial --label "RRT-Connect, 1 s budget"
+# Ablations of this project's deviations (success; both cores, so their times are not comparable).
+run original-strided --steps 10 --gradient-steps 4 --refine-steps 0 --step-limit inf --world-boxes \
+    --label "EDMP, strided K = 10, the original's costs and steps"
+run world-boxes --world-boxes
+run no-refine --refine-steps 0
+run no-step-limit --step-limit inf
+run k3 --steps 3
+run k10 --steps 10
+run k25 --steps 25 --gradient-steps 2
+# The original sampler (255 steps, guidance on even t), on 25 problems per family.
+run ancestral-original --ancestral --per-family 25 --refine-steps 0 --step-limit inf --world-boxes \
+    --label "EDMP, ancestral K = 255, the original's costs and steps"
+run ancestral --ancestral --per-family 25
+# Table III and Figure 7: each guide alone (12 rows of it).
+for g in 1 2 3 4 5 10 11 13 14 16 18 21; do
+    run "guide-$g" --guides "$g"
+done
+# Figure 6: prefixes of the guides interleaving iv and sv (1 guide is guide-1 above).
+run guides-2 --guides 1,10
+run guides-3 --guides 1,10,2
+run guides-4 --guides 1,10,2,11
+run guides-6 --guides 1,10,2,11,4,18
+
+runs=()
+for name in edmp rrt original-strided world-boxes no-refine no-step-limit k3 k10 k25 \
+    ancestral-original ancestral guides-2 guides-3 guides-4 guides-6 \
+    guide-1 guide-2 guide-3 guide-4 guide-5 guide-10 guide-11 guide-13 guide-14 guide-16 guide-18 guide-21; do
+    [ -f "$OUT/$name/results.jsonl" ] && runs+=("$OUT/$name")
+done
+"$B" bench-report "${runs[@]}" -o docs/benchmark > /dev/null
+echo "report: docs/benchmark/report.md"
