@@ -1,6 +1,9 @@
-//! `edmp-host render`: a picture of a scene (and of a plan): a top view and a side view,
+//! `edmp-host render`: a picture of a scene (and of a plan): a top, a side and a front view,
 //! orthographic, obstacles in grey, the robot's collision hulls at the start (blue) and the
-//! goal (green), and with a plan its waypoints in orange, fading along the trajectory.
+//! goal (green), and with a plan every fourth waypoint in orange, fading in along the
+//! trajectory, and the path of the TCP in dark red. `--candidates` overlays the TCP path of
+//! every candidate of the ensemble (plans written with `edmp-host plan --candidates`): one
+//! colour per collision-free candidate, grey for colliding ones.
 //! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
 
 use crate::json::{Goal, parse_problem};
@@ -21,13 +24,37 @@ pub(crate) struct Args {
     /// Output PNG.
     #[arg(short, long)]
     output: PathBuf,
+    /// Overlay the TCP path of every candidate in the plan (multimodality).
+    #[arg(long)]
+    candidates: bool,
 }
 
 const PANEL: usize = 600;
-/// World window of both views: x (forward) and the second axis (y for the top view, z for the side).
+/// World window of the views: x (forward), y (left), z (up).
 const X_RANGE: [f32; 2] = [-0.5, 1.4];
-const TOP_RANGE: [f32; 2] = [-0.95, 0.95];
-const SIDE_RANGE: [f32; 2] = [-0.15, 1.75];
+const Y_RANGE: [f32; 2] = [-0.95, 0.95];
+const Z_RANGE: [f32; 2] = [-0.15, 1.75];
+
+/// The three panels, left to right: top (x right, y up), side (x right, z up), front (seen
+/// from +x: y right, z up).
+const VIEWS: [View; 3] = [View::Top, View::Side, View::Front];
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum View {
+    Top,
+    Side,
+    Front,
+}
+
+/// Colours of the candidates' TCP paths.
+const CANDIDATE_COLOURS: [[f32; 3]; 6] = [
+    [0.12, 0.47, 0.71],
+    [0.17, 0.63, 0.17],
+    [0.58, 0.40, 0.74],
+    [0.89, 0.47, 0.76],
+    [0.09, 0.75, 0.81],
+    [0.74, 0.74, 0.13],
+];
 
 /// An RGB raster with alpha-blended convex fills (no anti-aliasing).
 pub(crate) struct Canvas {
@@ -166,19 +193,65 @@ fn outline(p: &Primitive) -> Vec<Vector3<f32>> {
     out
 }
 
-/// Pixel of world point `p` in the top (`side = false`) or side view, with the panel offset.
-fn pixel(p: &Vector3<f32>, side: bool) -> [f32; 2] {
-    let u = (p.x - X_RANGE[0]) / (X_RANGE[1] - X_RANGE[0]) * PANEL as f32;
-    let (range, v) = if side { (SIDE_RANGE, p.z) } else { (TOP_RANGE, p.y) };
-    let v = (1.0 - (v - range[0]) / (range[1] - range[0])) * PANEL as f32;
-    [u + if side { PANEL as f32 } else { 0.0 }, v]
+/// Pixel of world point `p` in a view, with the panel offset.
+fn pixel(p: &Vector3<f32>, view: View) -> [f32; 2] {
+    let scale = |x: f32, range: [f32; 2]| (x - range[0]) / (range[1] - range[0]) * PANEL as f32;
+    let (u, v, panel) = match view {
+        View::Top => (scale(p.x, X_RANGE), scale(p.y, Y_RANGE), 0),
+        View::Side => (scale(p.x, X_RANGE), scale(p.z, Z_RANGE), 1),
+        View::Front => (scale(p.y, Y_RANGE), scale(p.z, Z_RANGE), 2),
+    };
+    [u + (panel * PANEL) as f32, PANEL as f32 - v]
 }
 
 fn draw(canvas: &mut Canvas, points: &[Vector3<f32>], color: [f32; 3], alpha: f32) {
-    for side in [false, true] {
-        let poly = hull2(points.iter().map(|p| pixel(p, side)).collect());
+    for view in VIEWS {
+        let poly = hull2(points.iter().map(|p| pixel(p, view)).collect());
         canvas.fill(&poly, color, alpha);
     }
+}
+
+/// The TCP's path along a trajectory, as a polyline in every view.
+fn draw_tcp_path(
+    canvas: &mut Canvas,
+    path: &[Joints<f32>],
+    width: f32,
+    color: [f32; 3],
+    alpha: f32,
+) -> Result<(), String> {
+    let points: Vec<Vector3<f32>> = path
+        .iter()
+        .map(|q| forward(q).map(|k| k.tcp().translation).map_err(|e| e.to_string()))
+        .collect::<Result<_, _>>()?;
+    for view in VIEWS {
+        for pair in points.windows(2) {
+            canvas.line(pixel(&pair[0], view), pixel(&pair[1], view), width, color, alpha);
+        }
+    }
+    Ok(())
+}
+
+/// Waypoints of a plan-like JSON value (`{"waypoints": [[7 numbers], ...]}`), named by `at`.
+fn waypoints(value: &serde_json::Value, at: &str) -> Result<Vec<Joints<f32>>, String> {
+    let rows = value["waypoints"]
+        .as_array()
+        .ok_or(format!("{at}.waypoints: expected an array"))?;
+    rows.iter()
+        .enumerate()
+        .map(|(i, w)| {
+            let q: Vec<f32> = w
+                .as_array()
+                .map(|a| {
+                    a.iter()
+                        .filter_map(serde_json::Value::as_f64)
+                        .map(|x| x as f32)
+                        .collect()
+                })
+                .unwrap_or_default();
+            q.try_into()
+                .map_err(|_| format!("{at}.waypoints[{i}]: expected 7 numbers"))
+        })
+        .collect()
 }
 
 fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, color: [f32; 3], alpha: f32) -> Result<(), String> {
@@ -195,54 +268,80 @@ fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, color: [f32; 3], alpha: f32)
 pub(crate) fn run(args: &Args) -> Result<(), String> {
     let text = std::fs::read_to_string(&args.scene).map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let problem = parse_problem(&text).map_err(|e| format!("{}: {e}", args.scene.display()))?;
-    let mut canvas = Canvas::new(2 * PANEL, PANEL);
-    // Panel frames and the floor line of the side view.
-    canvas.fill(
-        &[
-            [PANEL as f32 - 1.0, 0.0],
-            [PANEL as f32 + 1.0, 0.0],
-            [PANEL as f32 + 1.0, PANEL as f32],
-            [PANEL as f32 - 1.0, PANEL as f32],
-        ],
-        [0.3; 3],
-        1.0,
-    );
-    let floor = pixel(&Vector3::new(0.0, 0.0, 0.0), true)[1];
-    canvas.fill(
-        &[
-            [PANEL as f32, floor],
-            [2.0 * PANEL as f32, floor],
-            [2.0 * PANEL as f32, floor + 1.0],
-            [PANEL as f32, floor + 1.0],
-        ],
-        [0.6; 3],
-        1.0,
-    );
+    let plan: Option<serde_json::Value> = match &args.plan {
+        Some(path) => Some(
+            serde_json::from_str(&std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?)
+                .map_err(|e| format!("{}: {e}", path.display()))?,
+        ),
+        None => None,
+    };
+    let mut canvas = Canvas::new(VIEWS.len() * PANEL, PANEL);
+    // Panel frames and the floor line of the side and front views.
+    for panel in 1..VIEWS.len() {
+        let x = (panel * PANEL) as f32;
+        canvas.fill(
+            &[
+                [x - 1.0, 0.0],
+                [x + 1.0, 0.0],
+                [x + 1.0, PANEL as f32],
+                [x - 1.0, PANEL as f32],
+            ],
+            [0.3; 3],
+            1.0,
+        );
+        let floor = pixel(&Vector3::zeros(), View::Side)[1];
+        canvas.fill(
+            &[
+                [x, floor],
+                [x + PANEL as f32, floor],
+                [x + PANEL as f32, floor + 1.0],
+                [x, floor + 1.0],
+            ],
+            [0.6; 3],
+            1.0,
+        );
+    }
     for o in problem.scene.obstacles() {
         draw(&mut canvas, &outline(&Primitive::obstacle(o)), [0.35, 0.35, 0.38], 0.45);
     }
-    if let Some(path) = &args.plan {
-        let plan: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?)
-                .map_err(|e| format!("{}: {e}", path.display()))?;
-        let waypoints = plan["waypoints"]
-            .as_array()
-            .ok_or(format!("{}: waypoints: expected an array", path.display()))?;
-        let n = waypoints.len().max(1);
-        for (i, w) in waypoints.iter().enumerate().step_by(4) {
-            let q: Vec<f32> = w
-                .as_array()
-                .map(|a| a.iter().filter_map(|x| x.as_f64()).map(|x| x as f32).collect())
-                .unwrap_or_default();
-            let q: Joints<f32> = q
-                .try_into()
-                .map_err(|_| format!("{}: waypoints[{i}]: expected 7 numbers", path.display()))?;
-            draw_robot(&mut canvas, &q, [0.95, 0.55, 0.1], 0.08 + 0.2 * i as f32 / n as f32)?;
+    let path = match (&plan, &args.plan) {
+        (Some(plan), Some(file)) => Some(waypoints(plan, &file.display().to_string())?),
+        _ => None,
+    };
+    if let Some(path) = &path {
+        let n = path.len().max(1);
+        for (i, q) in path.iter().enumerate().step_by(4) {
+            draw_robot(&mut canvas, q, [0.95, 0.55, 0.1], 0.08 + 0.2 * i as f32 / n as f32)?;
         }
     }
     draw_robot(&mut canvas, &problem.start, [0.15, 0.35, 0.85], 0.35)?;
     if let Goal::Joints(goal) = problem.goal {
         draw_robot(&mut canvas, &goal, [0.1, 0.65, 0.25], 0.35)?;
+    }
+    if args.candidates {
+        let list = plan
+            .as_ref()
+            .and_then(|p| p["candidates"].as_array())
+            .ok_or("--candidates: the plan has no candidates (write it with `edmp-host plan --candidates`)")?;
+        let mut free = 0;
+        for (i, c) in list.iter().enumerate() {
+            let colour = if c["collision_free"].as_bool() == Some(true) {
+                free += 1;
+                CANDIDATE_COLOURS[(free - 1) % CANDIDATE_COLOURS.len()]
+            } else {
+                [0.55; 3]
+            };
+            draw_tcp_path(
+                &mut canvas,
+                &waypoints(c, &format!("candidates[{i}]"))?,
+                2.0,
+                colour,
+                0.8,
+            )?;
+        }
+    }
+    if let Some(path) = &path {
+        draw_tcp_path(&mut canvas, path, 3.5, [0.6, 0.05, 0.05], 0.95)?;
     }
     canvas.png(&args.output)
 }

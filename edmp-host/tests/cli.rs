@@ -53,16 +53,56 @@ fn bad_input_names_the_field_exits_2_and_writes_nothing() {
 }
 
 #[test]
-fn render_writes_a_png() {
-    let path = std::env::temp_dir().join(format!("edmp-render-{}.png", std::process::id()));
-    let out = edmp_host(&["render", "examples/wall.json", "-o", path.to_str().unwrap()]);
+fn render_writes_a_png_of_the_scene_and_of_a_plan_with_its_candidates() {
+    let dir = std::env::temp_dir().join(format!("edmp-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, plan) = (dir.join("scene.png"), dir.join("plan.json"));
+    let size = |path: &std::path::Path| {
+        let bytes = std::fs::read(path).unwrap();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+        // IHDR: width, height.
+        (
+            u32::from_be_bytes([bytes[16], bytes[17], bytes[18], bytes[19]]),
+            u32::from_be_bytes([bytes[20], bytes[21], bytes[22], bytes[23]]),
+        )
+    };
+    let out = edmp_host(&["render", "examples/wall.json", "-o", png.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let bytes = std::fs::read(&path).unwrap();
-    std::fs::remove_file(&path).ok();
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
-    // IHDR: width 1200, height 600.
-    assert_eq!(u32::from_be_bytes([bytes[16], bytes[17], bytes[18], bytes[19]]), 1200);
-    assert_eq!(u32::from_be_bytes([bytes[20], bytes[21], bytes[22], bytes[23]]), 600);
+    assert_eq!(size(&png), (1800, 600), "three 600 × 600 views");
+    let bare = std::fs::read(&png).unwrap();
+    // --candidates needs a plan written with them.
+    let out = edmp_host(&["plan", "examples/wall.json", "-o", plan.to_str().unwrap()]);
+    assert!(out.status.success());
+    let out = edmp_host(&[
+        "render",
+        "examples/wall.json",
+        plan.to_str().unwrap(),
+        "--candidates",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--candidates"));
+    let out = edmp_host(&[
+        "plan",
+        "examples/wall.json",
+        "--candidates",
+        "-o",
+        plan.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let out = edmp_host(&[
+        "render",
+        "examples/wall.json",
+        plan.to_str().unwrap(),
+        "--candidates",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(size(&png), (1800, 600));
+    assert_ne!(std::fs::read(&png).unwrap(), bare, "the plan is drawn");
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
