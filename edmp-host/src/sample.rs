@@ -10,7 +10,7 @@ use crate::json::{Goal, parse_problem};
 use crate::metrics::{Roughness, roughness, step_norm};
 use crate::render::Canvas;
 use edmp_core::checker::{CheckConfig, check_trajectory};
-use edmp_core::prior::{HORIZON, Path, Sampler, Scratch, sample};
+use edmp_core::prior::{HORIZON, Path, Sampler, Scratch, sample_conditioned};
 use edmp_core::rng::Rng;
 use edmp_core::robot::{JOINTS, PANDA};
 use edmp_core::scene::Scene;
@@ -48,6 +48,10 @@ pub(crate) struct Args {
     /// Random seed (problem i uses seed + i).
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Also measure each sampler without start/goal conditioning (no inpainting while
+    /// denoising, ends written at the end): the paper's Table IV ablation.
+    #[arg(long)]
+    no_conditioning: bool,
 }
 
 fn parse_sampler(s: &str) -> Result<Sampler, String> {
@@ -210,12 +214,22 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
         })
         .unwrap_or(0);
     let mut plotted: Vec<(Sampler, [Path; BATCH])> = Vec::new();
-    for &sampler in &samplers {
+    let conditions: &[bool] = if args.no_conditioning { &[true, false] } else { &[true] };
+    let runs: Vec<(Sampler, bool)> = samplers
+        .iter()
+        .flat_map(|s| conditions.iter().map(move |c| (*s, *c)))
+        .collect();
+    for &(sampler, condition) in &runs {
+        let label = if condition {
+            name(sampler)
+        } else {
+            format!("{}, no conditioning", name(sampler))
+        };
         let bar = ProgressBar::new(problems.len() as u64).with_style(
             ProgressStyle::with_template("{msg:>18} {bar:40} {pos}/{len} [{elapsed} < {eta}]")
                 .map_err(|e| e.to_string())?,
         );
-        bar.set_message(name(sampler));
+        bar.set_message(label.clone());
         let results: Vec<Result<(f64, [Path; BATCH]), String>> = problems
             .par_iter()
             .enumerate()
@@ -223,8 +237,9 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
                 let mut scratch = Box::new(Scratch::<4>::new());
                 let mut out = Box::new([[[0.0f32; JOINTS]; HORIZON]; BATCH]);
                 let began = std::time::Instant::now();
-                sample(
+                sample_conditioned(
                     sampler,
+                    condition,
                     start,
                     goal,
                     &mut Rng::new(args.seed + i as u64),
@@ -249,13 +264,11 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
         let q: Vec<Quality> = paths.par_iter().flatten().map(|x| quality(x, &empty)).collect();
         println!(
             "{}",
-            row(
-                &name(sampler),
-                &q,
-                Some((percentile(&times, 0.5), percentile(&times, 0.95)))
-            )
+            row(&label, &q, Some((percentile(&times, 0.5), percentile(&times, 0.95))))
         );
-        plotted.push((sampler, paths[shown]));
+        if condition {
+            plotted.push((sampler, paths[shown]));
+        }
     }
     if let Some(path) = &args.plot {
         let first = plotted.first().map(|p| p.1);

@@ -111,8 +111,9 @@ impl Sampler {
         }
     }
 
-    /// Moves `x` from step `step.t` to `step.prev` given the network's `eps` (the noise draw,
-    /// ancestral only, comes from `rng`, one normal per entry, waypoint-major). Then re-inpaints.
+    /// Moves `x` from step `step.t` to `step.prev` given the network's `eps` (the noise draw
+    /// comes from `rng`, one normal per entry, waypoint-major). Then re-inpaints: the start/goal
+    /// conditioning of EDMP.
     pub fn update(
         &self,
         step: Step,
@@ -122,6 +123,13 @@ impl Sampler {
         start: &[f32; JOINTS],
         goal: &[f32; JOINTS],
     ) {
+        self.advance(step, x, eps, rng);
+        inpaint(x, start, goal);
+    }
+
+    /// [`Self::update`] without the inpainting: every waypoint, the ends included, follows the
+    /// network (the paper's "without conditioning" ablation, Table IV).
+    pub fn advance(&self, step: Step, x: &mut Path, eps: &Path, rng: &mut Rng) {
         let i = table_index(step.t);
         match *self {
             Self::Ancestral => {
@@ -174,7 +182,6 @@ impl Sampler {
                 }
             }
         }
-        inpaint(x, start, goal);
     }
 }
 
@@ -216,11 +223,34 @@ pub fn sample<const B: usize, const C: usize>(
     scratch: &mut Scratch<C>,
     out: &mut [Path; B],
 ) -> Result<(), Error> {
+    sample_conditioned(sampler, true, start, goal, rng, scratch, out)
+}
+
+/// [`sample`], or with `condition = false` the paper's unconditioned ablation: no inpainting
+/// while denoising (the noise starts free too); the start and goal are written into the ends
+/// only after the last step.
+pub fn sample_conditioned<const B: usize, const C: usize>(
+    sampler: Sampler,
+    condition: bool,
+    start: &[f32; JOINTS],
+    goal: &[f32; JOINTS],
+    rng: &mut Rng,
+    scratch: &mut Scratch<C>,
+    out: &mut [Path; B],
+) -> Result<(), Error> {
     sampler.validate()?;
     check_joints(start)?;
     check_joints(goal)?;
     for x in out.iter_mut() {
         initial_noise(x, rng, start, goal);
+        if !condition {
+            // The two ends' draws, had they not been inpainted (a second, independent draw).
+            for w in [0, HORIZON - 1] {
+                for v in x[w].iter_mut() {
+                    *v = rng.normal_f32();
+                }
+            }
+        }
     }
     let mut eps = [[[0.0f32; JOINTS]; HORIZON]; B];
     for j in 0..sampler.evaluations() {
@@ -228,7 +258,16 @@ pub fn sample<const B: usize, const C: usize>(
         let time = TimeEmbedding::new(step.t)?;
         predict_noise(out, &time, scratch, &mut eps)?;
         for (x, e) in out.iter_mut().zip(&eps) {
-            sampler.update(step, x, e, rng, start, goal);
+            if condition {
+                sampler.update(step, x, e, rng, start, goal);
+            } else {
+                sampler.advance(step, x, e, rng);
+            }
+        }
+    }
+    if !condition {
+        for x in out.iter_mut() {
+            inpaint(x, start, goal);
         }
     }
     Ok(())
