@@ -5,7 +5,7 @@
 #![no_main]
 
 use edmp_core::checker::CheckConfig;
-use edmp_core::geometry::CylinderBox;
+use edmp_core::geometry::{BoxFrame, CylinderBox};
 use edmp_core::guides::EDMP_GUIDES;
 use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
@@ -60,8 +60,9 @@ fuzz_target!(|data: &[u8]| {
         },
         guidance: GuidanceSchedule::Every { per_step: r.byte() % 3 },
         refine: r.byte() % 3,
-        step_limit: f32::INFINITY,
+        step_limit: if r.byte() & 1 == 0 { f32::INFINITY } else { 0.1 },
         cylinder: CylinderBox::Enclosing,
+        frame: if r.byte() & 1 == 0 { BoxFrame::Obstacle } else { BoxFrame::World },
         check: CheckConfig::default(),
     };
     let guides = &EDMP_GUIDES[..[1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)]];
