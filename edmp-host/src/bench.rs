@@ -85,6 +85,10 @@ pub(crate) struct Record {
     pub(crate) planner: String,
     /// Guides of the EDMP run (empty for RRT-Connect).
     pub(crate) guides: Vec<u8>,
+    /// The EDMP settings besides the guides (sampler, steps, limits, boxes; empty for
+    /// RRT-Connect): runs compare in ablations only when these agree.
+    #[serde(default)]
+    pub(crate) config: String,
     /// Random seed.
     pub(crate) seed: u64,
     /// `success` (passed the project's checker), `collision` (EDMP's least colliding
@@ -157,6 +161,7 @@ fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
         family: String::new(),
         planner: String::new(),
         guides: guides.iter().map(|g| g.id).collect(),
+        config: args.tuning.label(),
         seed: args.seed,
         status: if plan.is_free() { "success" } else { "collision" }.to_owned(),
         time_ms: planned.ik_ms + planned.denoise_ms + planned.select_ms,
@@ -202,6 +207,7 @@ fn run_rrt(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
         family: String::new(),
         planner: String::new(),
         guides: Vec::new(),
+        config: String::new(),
         seed: args.seed,
         status: status.to_owned(),
         time_ms,

@@ -47,6 +47,11 @@ impl Run {
     fn guides(&self) -> &[u8] {
         self.records.first().map_or(&[], |r| &r.guides)
     }
+
+    /// EDMP's settings besides the guides (empty for other planners).
+    fn config(&self) -> &str {
+        self.records.first().map_or("", |r| &r.config)
+    }
 }
 
 /// Writes the report and charts.
@@ -122,9 +127,15 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
     )?;
     let _ = writeln!(md, "\n![solved per family](success.png)\n\n![planning time](time.png)");
 
+    // The ablations compare EDMP runs that differ in their guides alone.
+    let reference = runs.iter().find(|r| !r.guides().is_empty()).map_or("", |r| r.config());
+    let comparable: Vec<&Run> = runs
+        .iter()
+        .filter(|r| !r.guides().is_empty() && r.config() == reference)
+        .collect();
     // Table III: the ensemble against the average single guide.
-    let singles: Vec<&Run> = runs.iter().filter(|r| r.guides().len() == 1).collect();
-    let ensembles: Vec<&Run> = runs.iter().filter(|r| r.guides().len() == 12).collect();
+    let singles: Vec<&Run> = comparable.iter().copied().filter(|r| r.guides().len() == 1).collect();
+    let ensembles: Vec<&Run> = comparable.iter().copied().filter(|r| r.guides().len() == 12).collect();
     if !singles.is_empty() && !ensembles.is_empty() {
         let _ = writeln!(
             md,
@@ -164,7 +175,7 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
 
     // Figure 6: success against the number of guides.
     let mut by_count: Vec<(usize, Vec<f64>)> = Vec::new();
-    for run in runs.iter().filter(|r| !r.guides().is_empty()) {
+    for run in &comparable {
         let n = run.guides().len();
         match by_count.iter_mut().find(|(c, _)| *c == n) {
             Some((_, v)) => v.push(run.success(None)),
