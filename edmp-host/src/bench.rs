@@ -353,17 +353,7 @@ fn write_outputs(dir: &Path, label: &str, records: &[Record]) -> Result<(), Stri
         100.0,
     )?;
     let curves: Vec<(String, Vec<(f64, f64)>)> = families.iter().map(|f| (f.clone(), cdf(records, f))).collect();
-    let t_max = records.iter().map(|r| r.time_ms).fold(1.0, f64::max);
-    plots::lines(
-        &dir.join("time.png"),
-        &format!("Planning time: {label}"),
-        "time (ms)",
-        "share of problems planned within (%)",
-        (0.0, t_max * 1.05),
-        (0.0, 100.0),
-        &curves,
-        false,
-    )
+    plots::time_distribution(&dir.join("time.png"), &format!("Planning time: {label}"), &curves)
 }
 
 /// The empirical distribution of one family's planning times, as (ms, %) steps.

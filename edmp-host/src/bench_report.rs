@@ -111,20 +111,7 @@ pub(crate) fn run(args: &Args) -> Result<(), String> {
         100.0,
     )?;
     let curves: Vec<(String, Vec<(f64, f64)>)> = runs.iter().map(|r| (r.label.clone(), cdf(&r.records, ""))).collect();
-    let t_max = runs
-        .iter()
-        .flat_map(|r| r.records.iter().map(|x| x.time_ms))
-        .fold(1.0, f64::max);
-    plots::lines(
-        &args.out.join("time.png"),
-        "Planning time, all problems",
-        "time (ms)",
-        "share of problems planned within (%)",
-        (0.0, t_max * 1.05),
-        (0.0, 100.0),
-        &curves,
-        false,
-    )?;
+    plots::time_distribution(&args.out.join("time.png"), "Planning time, all problems", &curves)?;
     let _ = writeln!(md, "\n![solved per family](success.png)\n\n![planning time](time.png)");
 
     // The ablations compare EDMP runs that differ in their guides alone.

@@ -158,3 +158,22 @@ pub(crate) fn lines(
         .map_err(fail(path))?;
     root.present().map_err(fail(path))
 }
+
+/// Distributions of planning times: per series, the share of problems planned within each time
+/// (steps from [`crate::bench::cdf`]), the time axis up to the slowest plan.
+pub(crate) fn time_distribution(path: &Path, title: &str, curves: &[(String, Vec<(f64, f64)>)]) -> Result<(), String> {
+    let t_max = curves
+        .iter()
+        .flat_map(|(_, points)| points.iter().map(|p| p.0))
+        .fold(1.0, f64::max);
+    lines(
+        path,
+        title,
+        "time (ms)",
+        "share of problems planned within (%)",
+        (0.0, t_max * 1.05),
+        (0.0, 100.0),
+        curves,
+        false,
+    )
+}
