@@ -2,9 +2,10 @@
 //! step let every row follow its guide, then judge every candidate with the exact checker and
 //! keep the free one with the lowest swept volume.
 //!
-//! Fixed work: the number of network forwards, cost gradients and checker states is set by the
-//! sampler, the guidance schedule and `B` (the checker's states by the path length, at most
-//! `MAX_STEPS_PER_SEGMENT` per segment), never by the scene's luck.
+//! Fixed work: the number of network forwards and cost gradients is set by the sampler, the
+//! guidance schedule and `B`, never by the scene's luck; the checker's states are bounded by
+//! the path length (at most `MAX_STEPS_PER_SEGMENT` per segment, each candidate checked at
+//! most twice: once to its first contact, once in full when no candidate is free).
 
 use crate::checker::{CheckConfig, check_trajectory};
 use crate::cost::{CostConfig, CostKind, trajectory_cost};
@@ -114,7 +115,9 @@ pub const DEFAULT_REFINE_STEPS: u8 = 48;
 impl PlanConfig {
     /// The shipped configuration, picked from the suite measurements in the README: the
     /// strided sampler with [`DEFAULT_STEPS`] steps, [`DEFAULT_GRADIENT_STEPS`] gradient steps
-    /// after each, enclosing boxes for cylinders, the project's checker.
+    /// after each, [`DEFAULT_REFINE_STEPS`] refinement steps, moves limited to
+    /// [`DEFAULT_STEP_LIMIT`], enclosing boxes for cylinders, obstacle-frame boxes, the
+    /// project's checker.
     pub const DEFAULT: Self = Self {
         sampler: Sampler::Strided { steps: DEFAULT_STEPS },
         guidance: GuidanceSchedule::Every {
@@ -395,6 +398,30 @@ mod tests {
         assert!(best.iter().all(|q| PANDA.within_soft_limits(q, 0.0)));
         let b = plan_wall(&GOAL, &mut scratch, &mut work).unwrap();
         assert_eq!(a, b);
+    }
+
+    #[test]
+    fn selection_stops_at_the_first_contact_unless_no_candidate_is_free() {
+        let scene = wall_scene();
+        let straight: Path = core::array::from_fn(|w| {
+            let s = w as f32 / (HORIZON - 1) as f32;
+            core::array::from_fn(|j| START[j] + s * (GOAL[j] - START[j]))
+        });
+        let cfg = config();
+        // None free: every candidate's contacts are counted in full; ties go to the lower row.
+        let none = select(&scene, &START, &GOAL, &cfg, [straight, straight]).unwrap();
+        assert!(!none.is_free());
+        assert!(none.verdicts.iter().all(|v| !v.free && v.colliding_states > 1));
+        assert_eq!(none.best, 0);
+        // One free: it wins, and the colliding one's check stopped at its first contact.
+        let mut scratch = Box::new(Scratch::<4>::new());
+        let mut work = Box::new(Workspace::<12>::new());
+        let planned = plan_wall(&GOAL, &mut scratch, &mut work).unwrap();
+        let free = planned.paths[planned.best];
+        let one = select(&scene, &START, &GOAL, &cfg, [straight, free]).unwrap();
+        assert_eq!(one.best, 1);
+        assert!(one.verdicts[1].free && one.verdicts[1].colliding_states == 0);
+        assert!(!one.verdicts[0].free && one.verdicts[0].colliding_states == 1);
     }
 
     #[test]
