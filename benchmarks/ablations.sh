@@ -28,6 +28,7 @@ run original-strided --steps 10 --gradient-steps 4 --refine-steps 0 --step-limit
 run world-boxes --world-boxes
 run no-refine --refine-steps 0
 run no-step-limit --step-limit inf
+run no-conditioning --no-conditioning
 run k3 --steps 3
 run k10 --steps 10
 run k25 --steps 25 --gradient-steps 2
@@ -46,7 +47,7 @@ run guides-4 --guides 1,10,2,11
 run guides-6 --guides 1,10,2,11,4,18
 
 runs=()
-for name in edmp rrt original-strided world-boxes no-refine no-step-limit k3 k10 k25 \
+for name in edmp rrt original-strided world-boxes no-refine no-step-limit no-conditioning k3 k10 k25 \
     ancestral-original ancestral guides-2 guides-3 guides-4 guides-6 \
     guide-1 guide-2 guide-3 guide-4 guide-5 guide-10 guide-11 guide-13 guide-14 guide-16 guide-18 guide-21; do
     [ -f "$OUT/$name/results.jsonl" ] && runs+=("$OUT/$name")

@@ -14,7 +14,7 @@ use crate::geometry::{BoxFrame, CylinderBox, Inflation};
 use crate::guidance::guide_step;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::prior::{HORIZON, Path, Sampler, Scratch, TimeEmbedding, initial_noise, predict_noise};
+use crate::prior::{HORIZON, Path, Sampler, Scratch, TimeEmbedding, free_ends, initial_noise, inpaint, predict_noise};
 use crate::rng::Rng;
 use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
@@ -56,6 +56,10 @@ pub struct PlanConfig {
     pub sampler: Sampler,
     /// When the guides act.
     pub guidance: GuidanceSchedule,
+    /// EDMP's start/goal conditioning: the ends are written in after every denoising step.
+    /// `false` is the paper's unconditioned ablation: they are written in only after the last
+    /// denoising step (before the refinement).
+    pub condition: bool,
     /// Gradient steps of every guide after the last denoising step, with each guide's schedule
     /// at t = 1 (no expansion, its own clearance and step size): a deviation from the original,
     /// which stops at the last denoising step; measured in the README.
@@ -123,6 +127,7 @@ impl PlanConfig {
         guidance: GuidanceSchedule::Every {
             per_step: DEFAULT_GRADIENT_STEPS,
         },
+        condition: true,
         refine: DEFAULT_REFINE_STEPS,
         step_limit: DEFAULT_STEP_LIMIT,
         cylinder: CylinderBox::Enclosing,
@@ -231,13 +236,20 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
     }
     for x in paths.iter_mut() {
         initial_noise(x, rng, start, goal);
+        if !config.condition {
+            free_ends(x, rng);
+        }
     }
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
         predict_noise(paths, &time, scratch, &mut work.eps)?;
         for (x, e) in paths.iter_mut().zip(&work.eps) {
-            config.sampler.update(step, x, e, rng, start, goal);
+            if config.condition {
+                config.sampler.update(step, x, e, rng, start, goal);
+            } else {
+                config.sampler.advance(step, x, e, rng);
+            }
         }
         for _ in 0..config.guidance.steps_at(step.t) {
             guide_step(
@@ -250,6 +262,11 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
                 config.cylinder,
                 config.frame,
             )?;
+        }
+    }
+    if !config.condition {
+        for x in paths.iter_mut() {
+            inpaint(x, start, goal);
         }
     }
     for _ in 0..config.refine {
@@ -349,6 +366,7 @@ mod tests {
         PlanConfig {
             sampler: Sampler::Strided { steps: 10 },
             guidance: GuidanceSchedule::Every { per_step: 4 },
+            condition: true,
             refine: 0,
             step_limit: f32::INFINITY,
             cylinder: CylinderBox::Enclosing,
@@ -422,6 +440,42 @@ mod tests {
         assert_eq!(one.best, 1);
         assert!(one.verdicts[1].free && one.verdicts[1].colliding_states == 0);
         assert!(!one.verdicts[0].free && one.verdicts[0].colliding_states == 1);
+    }
+
+    #[test]
+    fn without_conditioning_the_ends_are_written_in_only_at_the_end() {
+        let scene = wall_scene();
+        let mut scratch = Box::new(Scratch::<4>::new());
+        let mut work = Box::new(Workspace::<12>::new());
+        let mut run = |condition: bool| {
+            let cfg = PlanConfig { condition, ..config() };
+            let mut paths = [[[0.0f32; JOINTS]; HORIZON]; 12];
+            denoise(
+                &scene,
+                &START,
+                &GOAL,
+                &EDMP_GUIDES,
+                &cfg,
+                &mut Rng::new(1),
+                &mut scratch,
+                &mut work,
+                &mut paths,
+            )
+            .unwrap();
+            paths
+        };
+        let (with, without) = (run(true), run(false));
+        for p in with.iter().chain(without.iter()) {
+            assert_eq!((p[0], p[HORIZON - 1]), (START, GOAL));
+        }
+        // The network never saw the ends: the first step is long.
+        let first_step = |p: &Path| {
+            p[0].iter()
+                .zip(&p[1])
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f32, f32::max)
+        };
+        assert!(first_step(&without[0]) > 5.0 * first_step(&with[0]));
     }
 
     #[test]

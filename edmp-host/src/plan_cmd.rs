@@ -62,6 +62,10 @@ pub(crate) struct Tuning {
     /// obstacle and robot box pair in the obstacle's frame).
     #[arg(long)]
     world_boxes: bool,
+    /// Without start/goal conditioning: the ends are written in only after the last denoising
+    /// step (the paper's ablation).
+    #[arg(long)]
+    no_conditioning: bool,
     /// EDMP's original sampler and guidance: 255 ancestral steps, guidance on even t ≥ 6.
     #[arg(long)]
     ancestral: bool,
@@ -83,6 +87,7 @@ impl Tuning {
                     per_step: self.gradient_steps,
                 }
             },
+            condition: !self.no_conditioning,
             refine: self.refine_steps,
             step_limit: self.step_limit,
             frame: if self.world_boxes {
@@ -110,7 +115,12 @@ impl Tuning {
 
     /// A short label for tables.
     pub(crate) fn label(&self) -> String {
-        let boxes = if self.world_boxes { ", world AABBs" } else { "" };
+        let boxes = match (self.world_boxes, self.no_conditioning) {
+            (false, false) => "",
+            (true, false) => ", world AABBs",
+            (false, true) => ", no conditioning",
+            (true, true) => ", world AABBs, no conditioning",
+        };
         let limit = if self.step_limit.is_finite() {
             format!("step limit {} rad", self.step_limit)
         } else {

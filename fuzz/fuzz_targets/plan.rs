@@ -59,6 +59,7 @@ fuzz_target!(|data: &[u8]| {
             Sampler::Ddim { steps }
         },
         guidance: GuidanceSchedule::Every { per_step: r.byte() % 3 },
+        condition: r.byte() & 1 == 0,
         refine: r.byte() % 3,
         step_limit: if r.byte() & 1 == 0 { f32::INFINITY } else { 0.1 },
         cylinder: CylinderBox::Enclosing,

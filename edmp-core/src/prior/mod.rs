@@ -205,6 +205,16 @@ pub fn initial_noise(x: &mut Path, rng: &mut Rng, start: &[f32; JOINTS], goal: &
     inpaint(x, start, goal);
 }
 
+/// Redraws the two ends of an [`initial_noise`] as standard normals (a second, independent
+/// draw): the starting point of the unconditioned ablation.
+pub fn free_ends(x: &mut Path, rng: &mut Rng) {
+    for w in [0, HORIZON - 1] {
+        for v in x[w].iter_mut() {
+            *v = rng.normal_f32();
+        }
+    }
+}
+
 fn check_joints(q: &[f32; JOINTS]) -> Result<(), Error> {
     match q.iter().position(|v| !v.is_finite()) {
         Some(joint) => Err(Error::NonFiniteJoint { joint: joint as u8 }),
@@ -244,12 +254,7 @@ pub fn sample_conditioned<const B: usize, const C: usize>(
     for x in out.iter_mut() {
         initial_noise(x, rng, start, goal);
         if !condition {
-            // The two ends' draws, had they not been inpainted (a second, independent draw).
-            for w in [0, HORIZON - 1] {
-                for v in x[w].iter_mut() {
-                    *v = rng.normal_f32();
-                }
-            }
+            free_ends(x, rng);
         }
     }
     let mut eps = [[[0.0f32; JOINTS]; HORIZON]; B];
