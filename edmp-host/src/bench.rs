@@ -91,6 +91,9 @@ pub(crate) struct Record {
     pub(crate) config: String,
     /// Random seed.
     pub(crate) seed: u64,
+    /// Planned one problem at a time (`--serial`): only then do times compare across runs.
+    #[serde(default)]
+    pub(crate) serial: bool,
     /// `success` (passed the project's checker), `collision` (EDMP's least colliding
     /// candidate) or `failure` (RRT-Connect found nothing within its budget).
     pub(crate) status: String,
@@ -163,6 +166,7 @@ fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
         guides: guides.iter().map(|g| g.id).collect(),
         config: args.tuning.label(),
         seed: args.seed,
+        serial: args.serial,
         status: if plan.is_free() { "success" } else { "collision" }.to_owned(),
         time_ms: planned.ik_ms + planned.denoise_ms + planned.select_ms,
         path_length: Some(path_length(best)),
@@ -209,6 +213,7 @@ fn run_rrt(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
         guides: Vec::new(),
         config: String::new(),
         seed: args.seed,
+        serial: args.serial,
         status: status.to_owned(),
         time_ms,
         path_length: (!waypoints.is_empty()).then(|| path_length(&waypoints)),

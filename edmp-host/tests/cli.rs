@@ -391,7 +391,7 @@ fn bench_writes_results_summary_and_charts_and_bench_report_compares_runs() {
         dir.join("report"),
     );
     for (out, extra) in [
-        (&edmp, vec![]),
+        (&edmp, vec!["--serial"]),
         (&single, vec!["--guides", "1"]),
         (&rrt, vec!["--planner", "rrt-connect"]),
     ] {
