@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every planner run behind docs/benchmark.md and the README's planner table, then the report.
 # Runs land in bench-out/<name>/ (results.jsonl, summary.md, charts); the report in
-# docs/benchmark/. About 25 minutes on the 2-core development machine.
+# docs/benchmark/. About 15 minutes on the 2-core development machine (measured: 14 min).
 #   benchmarks/ablations.sh            # everything
 #   ONLY="edmp rrt" benchmarks/ablations.sh
 set -euo pipefail
