@@ -14,7 +14,9 @@ use crate::geometry::{BoxFrame, CylinderBox, Inflation};
 use crate::guidance::guide_step;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::prior::{HORIZON, Path, Sampler, Scratch, TimeEmbedding, free_ends, initial_noise, inpaint, predict_noise};
+use crate::prior::{
+    HORIZON, Path, Sampler, Scratch, TimeEmbedding, check_joints, free_ends, initial_noise, inpaint, predict_noise,
+};
 use crate::rng::Rng;
 use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
@@ -189,13 +191,6 @@ impl<const B: usize> Workspace<B> {
     }
 }
 
-fn check_joints(q: &Joints<f32>) -> Result<(), Error> {
-    match q.iter().position(|v| !v.is_finite()) {
-        Some(joint) => Err(Error::NonFiniteJoint { joint: joint as u8 }),
-        None => Ok(()),
-    }
-}
-
 /// Plans from `start` to `goal` in `scene` with `B` rows over `guides` (`B` a multiple of
 /// `guides.len()`), drawing every random number from `rng`: the same inputs give the same bits.
 /// [`denoise`] then [`select`].
@@ -240,6 +235,19 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
             free_ends(x, rng);
         }
     }
+    // One gradient step of every row's guide at diffusion step `t`.
+    let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16| {
+        guide_step(
+            scene,
+            paths,
+            grads,
+            guides,
+            t,
+            config.step_limit,
+            config.cylinder,
+            config.frame,
+        )
+    };
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
@@ -252,16 +260,7 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
             }
         }
         for _ in 0..config.guidance.steps_at(step.t) {
-            guide_step(
-                scene,
-                paths,
-                &mut work.grads,
-                guides,
-                step.t,
-                config.step_limit,
-                config.cylinder,
-                config.frame,
-            )?;
+            guide(paths, &mut work.grads, step.t)?;
         }
     }
     if !config.condition {
@@ -270,16 +269,7 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
         }
     }
     for _ in 0..config.refine {
-        guide_step(
-            scene,
-            paths,
-            &mut work.grads,
-            guides,
-            1,
-            config.step_limit,
-            config.cylinder,
-            config.frame,
-        )?;
+        guide(paths, &mut work.grads, 1)?;
     }
     Ok(())
 }

@@ -215,7 +215,8 @@ pub fn free_ends(x: &mut Path, rng: &mut Rng) {
     }
 }
 
-fn check_joints(q: &[f32; JOINTS]) -> Result<(), Error> {
+/// A joint vector with a NaN or an infinity is a typed error naming the joint.
+pub(crate) fn check_joints(q: &[f32; JOINTS]) -> Result<(), Error> {
     match q.iter().position(|v| !v.is_finite()) {
         Some(joint) => Err(Error::NonFiniteJoint { joint: joint as u8 }),
         None => Ok(()),
