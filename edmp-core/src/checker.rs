@@ -20,10 +20,25 @@ use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Scene, Shape};
 use nalgebra::{Matrix3, Vector3};
 
-/// Clearance every contact test demands (metres). PyBullet inflates each mesh hull by its
-/// collision margin and calls any distance ≤ 0 contact; this margin covers that, measured on
-/// the recorded fixtures (see the tests and ARCHITECTURE.md).
+/// Clearance demanded between a robot body and an obstacle away from the ends (metres): the
+/// planner's own safety margin, twice what PyBullet's inflated hulls need.
 pub const DEFAULT_MARGIN: f32 = 0.002;
+/// How far PyBullet 3.2.7 inflates each robot hull (its collision margin): on the recorded
+/// fixtures our certified hull distance minus PyBullet's is at most 1.0004 mm (median 0.987),
+/// so PyBullet calls a hull in contact exactly when its true distance is ≤ about 1 mm.
+pub const PYBULLET_HULL_MARGIN: f32 = 0.001;
+/// Clearance demanded between a robot body and an obstacle near the ends: PyBullet's own
+/// contact rule (`spec/formats.md`, valid ends) plus 10 µm for the hulls' and the kinematics'
+/// differences. A grasp pose 0.05 mm above a table (by PyBullet) passes; one PyBullet finds
+/// touching never does.
+pub const END_MARGIN: f32 = PYBULLET_HULL_MARGIN + 0.000_01;
+/// Clearance demanded between two robot bodies, everywhere: both hulls are inflated, so
+/// PyBullet's zero distance is about 2 mm of ours.
+pub const SELF_MARGIN: f32 = 2.0 * END_MARGIN;
+/// Joint-space radius (max-norm, radians) around the start and the goal inside which
+/// [`END_MARGIN`] replaces [`DEFAULT_MARGIN`]: a path may leave a surface the user's end
+/// touches, and must be 2 mm clear once it is this far from the end.
+pub const END_RADIUS: f32 = 0.05;
 /// Largest joint step between checked states (`spec/formats.md`).
 pub const MAX_JOINT_STEP: f32 = 0.01;
 /// Fixed budget of interpolated states per segment: the widest joint range (6.6 rad) at
@@ -35,8 +50,14 @@ pub const HELD_BODY: u8 = BODIES as u8;
 /// Checker settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CheckConfig {
-    /// Required clearance between any two checked shapes.
+    /// Required clearance between a robot body (or the held object) and an obstacle.
     pub margin: f32,
+    /// The same near the ends (states within `end_radius` of the first or last waypoint).
+    pub end_margin: f32,
+    /// Max-norm joint distance from an end within which `end_margin` applies.
+    pub end_radius: f32,
+    /// Required clearance between two robot bodies (and the held object).
+    pub self_margin: f32,
     /// Largest per-joint step between checked states.
     pub max_step: f32,
     /// Check non-neighbour robot bodies against each other (on by default; off only to study
@@ -48,6 +69,9 @@ impl CheckConfig {
     /// The project's definition of a solved problem (`shared/spec/formats.md`).
     pub const DEFAULT: Self = Self {
         margin: DEFAULT_MARGIN,
+        end_margin: END_MARGIN,
+        end_radius: END_RADIUS,
+        self_margin: SELF_MARGIN,
         max_step: MAX_JOINT_STEP,
         self_collision: true,
     };
@@ -147,7 +171,10 @@ const PLACEHOLDER: Primitive = Primitive {
 struct Placed<'a> {
     k: &'a Kinematics<f32>,
     held: Option<Primitive>,
+    /// Obstacle clearance for this state.
     margin: f32,
+    /// Clearance between robot bodies.
+    self_margin: f32,
 }
 
 impl Placed<'_> {
@@ -176,13 +203,14 @@ impl Placed<'_> {
 
     /// Bodies `a < b` proven apart.
     fn bodies_apart(&self, a: usize, b: usize, hint: &mut Vector3<f32>) -> bool {
+        let m = self.self_margin;
         if b >= BODIES {
             return match &self.held {
-                Some(h) => self.body_apart_from(a, h, hint),
+                Some(h) => apart(&self.obb(a), h, m, hint) || apart(&self.hull(a), h, m, hint),
                 None => true,
             };
         }
-        apart(&self.obb(a), &self.obb(b), self.margin, hint) || apart(&self.hull(a), &self.hull(b), self.margin, hint)
+        apart(&self.obb(a), &self.obb(b), m, hint) || apart(&self.hull(a), &self.hull(b), m, hint)
     }
 }
 
@@ -206,7 +234,13 @@ impl<const N: usize> Hints<N> {
 }
 
 fn validate(config: &CheckConfig) -> Result<(), Error> {
-    let ok = config.margin.is_finite() && config.margin >= 0.0 && config.max_step.is_finite() && config.max_step > 0.0;
+    let distance = |x: f32| x.is_finite() && x >= 0.0;
+    let ok = distance(config.margin)
+        && distance(config.end_margin)
+        && distance(config.end_radius)
+        && distance(config.self_margin)
+        && config.max_step.is_finite()
+        && config.max_step > 0.0;
     if ok { Ok(()) } else { Err(Error::BadParameter) }
 }
 
@@ -264,21 +298,27 @@ impl<'s, const N: usize> Prepared<'s, N> {
         })
     }
 
-    /// The first contact at configuration `q`, if any.
-    fn contact_at(&mut self, q: &Joints<f32>) -> Result<Option<Contact>, Error> {
+    /// The first contact at configuration `q`, if any; `margin` is the obstacle clearance
+    /// this state must keep.
+    fn contact_at(&mut self, q: &Joints<f32>, margin: f32) -> Result<Option<Contact>, Error> {
         let k = forward(q)?;
-        let margin = self.config.margin;
+        let self_margin = self.config.self_margin;
         let held = self.scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME]));
         let center: [Vector3<f32>; SLOTS] = core::array::from_fn(|b| match (k.boxes.get(b), &held) {
             (Some(pose), _) => pose.translation,
             (None, Some(h)) => h.center,
             (None, None) => Vector3::zeros(),
         });
-        let near = |c1: &Vector3<f32>, r1: f32, c2: &Vector3<f32>, r2: f32| {
+        let near = |c1: &Vector3<f32>, r1: f32, c2: &Vector3<f32>, r2: f32, margin: f32| {
             let reach = r1 + r2 + margin;
             (c1 - c2).norm_squared() <= reach * reach
         };
-        let placed = Placed { k: &k, held, margin };
+        let placed = Placed {
+            k: &k,
+            held,
+            margin,
+            self_margin,
+        };
         let count = self.scene.obstacles().len();
         for b in (0..self.shapes).filter(|&b| moves(b)) {
             let candidates = self
@@ -287,7 +327,8 @@ impl<'s, const N: usize> Prepared<'s, N> {
                 .zip(self.obstacle_radius.iter())
                 .zip(self.hints.obstacle[b % SLOTS].iter_mut());
             for (i, ((o, &r), hint)) in candidates.take(count).enumerate() {
-                if near(&center[b % SLOTS], self.radius[b % SLOTS], &o.center, r) && !placed.body_apart_from(b, o, hint)
+                if near(&center[b % SLOTS], self.radius[b % SLOTS], &o.center, r, margin)
+                    && !placed.body_apart_from(b, o, hint)
                 {
                     return Ok(Some(Contact::Obstacle {
                         body: b as u8,
@@ -302,7 +343,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
         for &(a, b) in self.pairs.iter().take(self.pair_count) {
             // `% SLOTS`: pairs hold shape indices below SLOTS; the modulo proves it to the compiler.
             let (a, b) = (usize::from(a) % SLOTS, usize::from(b) % SLOTS);
-            if near(&center[a], self.radius[a], &center[b], self.radius[b])
+            if near(&center[a], self.radius[a], &center[b], self.radius[b], self_margin)
                 && !placed.bodies_apart(a, b, &mut self.hints.body[a][b])
             {
                 return Ok(Some(Contact::SelfContact {
@@ -315,14 +356,24 @@ impl<'s, const N: usize> Prepared<'s, N> {
     }
 }
 
-/// Checks one configuration: the first contact found, or `None` when every pair is proven
-/// apart by more than the margin.
+/// Checks one configuration away from the ends: the first contact found, or `None` when
+/// every pair is proven apart by more than its margin.
 pub fn check_state<const N: usize>(
     scene: &Scene<N>,
     q: &Joints<f32>,
     config: &CheckConfig,
 ) -> Result<Option<Contact>, Error> {
-    Prepared::new(scene, config)?.contact_at(q)
+    Prepared::new(scene, config)?.contact_at(q, config.margin)
+}
+
+/// Checks a start or goal as the user gave it: obstacles at `end_margin`, PyBullet's own
+/// contact rule (`spec/formats.md`, valid ends), not the planner's margin.
+pub fn check_end<const N: usize>(
+    scene: &Scene<N>,
+    q: &Joints<f32>,
+    config: &CheckConfig,
+) -> Result<Option<Contact>, Error> {
+    Prepared::new(scene, config)?.contact_at(q, config.end_margin)
 }
 
 /// A certified lower bound on the distance from the moving robot bodies' hulls (and the held
@@ -347,12 +398,48 @@ pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f3
     Ok(best)
 }
 
-/// Checks every waypoint and every interpolated state between consecutive waypoints.
-/// With `stop_at_first`, returns at the first contact (the report then counts states only up
-/// to it); otherwise counts every colliding state.
+/// Checks every waypoint and every interpolated state between consecutive waypoints; the
+/// first and last waypoints are the ends (states within `end_radius` of them keep
+/// `end_margin` from obstacles, the rest `margin`). With `stop_at_first`, returns at the first
+/// contact (the report then counts states only up to it); otherwise counts every colliding
+/// state.
 pub fn check_trajectory<const H: usize, const N: usize>(
     scene: &Scene<N>,
     trajectory: &[Joints<f32>; H],
+    config: &CheckConfig,
+    stop_at_first: bool,
+) -> Result<TrajectoryReport, Error> {
+    let (Some(first), Some(last)) = (trajectory.first(), trajectory.last()) else {
+        return Ok(TrajectoryReport {
+            states: 0,
+            colliding_states: 0,
+            first_contact: None,
+        });
+    };
+    check_path(scene, trajectory, [first, last], config, stop_at_first)
+}
+
+/// Checks the straight segment `a → b` (both ends included) of a path whose ends are `ends`
+/// (the problem's start and goal): what a search over the checker asks of each edge.
+pub fn check_segment<const N: usize>(
+    scene: &Scene<N>,
+    a: &Joints<f32>,
+    b: &Joints<f32>,
+    ends: [&Joints<f32>; 2],
+    config: &CheckConfig,
+) -> Result<bool, Error> {
+    Ok(check_path(scene, &[*a, *b], ends, config, true)?.is_free())
+}
+
+/// Whether `q` lies within `radius` (max-norm) of `end`.
+fn within(q: &Joints<f32>, end: &Joints<f32>, radius: f32) -> bool {
+    q.iter().zip(end.iter()).all(|(x, y)| (x - y).abs() <= radius)
+}
+
+fn check_path<const N: usize>(
+    scene: &Scene<N>,
+    trajectory: &[Joints<f32>],
+    ends: [&Joints<f32>; 2],
     config: &CheckConfig,
     stop_at_first: bool,
 ) -> Result<TrajectoryReport, Error> {
@@ -374,7 +461,9 @@ pub fn check_trajectory<const H: usize, const N: usize>(
                 None => *q,
             };
             report.states += 1;
-            if let Some(contact) = prepared.contact_at(&state)? {
+            let near_end = ends.iter().any(|e| within(&state, e, config.end_radius));
+            let margin = if near_end { config.end_margin } else { config.margin };
+            if let Some(contact) = prepared.contact_at(&state, margin)? {
                 report.colliding_states += 1;
                 if report.first_contact.is_none() {
                     report.first_contact = Some(StateContact {

@@ -12,6 +12,13 @@ use nalgebra::{Matrix3, Vector3};
 pub trait Convex {
     /// A point of the set maximising `⟨p, d⟩` (any point for `d = 0`).
     fn support(&self, d: &Vector3<f32>) -> Vector3<f32>;
+
+    /// World directions (columns) normal to the set's faces, if it has a few known ones. When
+    /// a flat face meets another shape, the exact separating direction is that face's normal,
+    /// which GJK on a large Minkowski difference reaches only to f32's precision.
+    fn face_normals(&self) -> Option<Matrix3<f32>> {
+        None
+    }
 }
 
 /// The convex hull of points given in a frame placed at `pose`.
@@ -118,6 +125,14 @@ impl Convex for Primitive {
             }
         };
         self.rotation * p + self.center
+    }
+
+    fn face_normals(&self) -> Option<Matrix3<f32>> {
+        match self.shape {
+            // A cylinder's caps are normal to its z; its other columns are merely valid axes.
+            Shape::Cuboid { .. } | Shape::Cylinder { .. } => Some(self.rotation),
+            Shape::Sphere { .. } => None,
+        }
     }
 }
 

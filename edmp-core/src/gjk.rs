@@ -15,6 +15,10 @@ pub const MAX_ITERATIONS: usize = 48;
 
 type V = Vector3<f32>;
 
+/// Relative volume (|det| over the product of the edge lengths) below which a tetrahedron
+/// counts as flat.
+const FLAT: f32 = 1e-4;
+
 /// Up to four vertices of the Minkowski difference; only the first `n` are in use.
 type Simplex = [V; 4];
 
@@ -88,32 +92,70 @@ pub fn apart<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> b
     if len > 0.0 && gap_along(a, b, &(*hint / len)) > margin {
         return true;
     }
-    match closest(a, b, hint) {
-        None => false,
-        Some(v) => {
-            let len = libm::sqrtf(v.norm_squared());
-            if !(len > 0.0 && len.is_finite()) {
-                return false;
-            }
-            *hint = v;
-            gap_along(a, b, &(v / len)) > margin
+    let mut start = *hint;
+    for _ in 0..RESTARTS {
+        let Some(v) = closest(a, b, &start) else {
+            return false;
+        };
+        let len = libm::sqrtf(v.norm_squared());
+        if !(len > 0.0 && len.is_finite()) {
+            return false;
         }
+        *hint = v;
+        if gap_along(a, b, &(v / len)) > margin {
+            return true;
+        }
+        // `len` bounds the distance from above: at or below the margin the pair is in reach,
+        // and no restart can prove otherwise.
+        if len <= margin {
+            return false;
+        }
+        if face_gap(a, b, &v) > margin {
+            return true;
+        }
+        start = v;
     }
+    false
 }
 
-/// A certified lower bound on the distance between `a` and `b` (zero when they may touch).
-pub fn distance_lower_bound<A: Convex, B: Convex>(a: &A, b: &B) -> f32 {
-    match closest(a, b, &V::x()) {
-        None => 0.0,
-        Some(v) => {
-            let len = libm::sqrtf(v.norm_squared());
-            if len > 0.0 {
-                gap_along(a, b, &(v / len)).max(0.0)
-            } else {
-                0.0
-            }
+/// The best exact lower bound along the shapes' face normals, each turned to point from `b`
+/// towards `a` like `towards` (a direction GJK found): tight where a face meets the other
+/// shape, where GJK's own direction is off by f32's precision times the shapes' size.
+fn face_gap<A: Convex, B: Convex>(a: &A, b: &B, towards: &V) -> f32 {
+    let mut best = f32::NEG_INFINITY;
+    for normals in [a.face_normals(), b.face_normals()].into_iter().flatten() {
+        for n in normals.column_iter() {
+            let n = if n.dot(towards) < 0.0 { -n } else { n.into_owned() };
+            best = best.max(gap_along(a, b, &n));
         }
     }
+    best
+}
+
+/// GJK runs [`apart`] allows for one pair: a run that stalls on a curved surface short of its
+/// bound (upper bound above the margin, certified gap below it) starts again from the
+/// direction it reached, with a fresh simplex.
+pub const RESTARTS: usize = 3;
+
+/// A certified lower bound on the distance between `a` and `b` (zero when they may touch).
+/// Restarts as [`apart`] does while the bound stays short of GJK's upper bound.
+pub fn distance_lower_bound<A: Convex, B: Convex>(a: &A, b: &B) -> f32 {
+    let (mut best, mut start) = (0.0f32, V::x());
+    for _ in 0..RESTARTS {
+        let Some(v) = closest(a, b, &start) else {
+            break;
+        };
+        let len = libm::sqrtf(v.norm_squared());
+        if !(len > 0.0 && len.is_finite()) {
+            break;
+        }
+        best = best.max(gap_along(a, b, &(v / len))).max(face_gap(a, b, &v));
+        if best >= len * (1.0 - 1e-4) {
+            break;
+        }
+        start = v;
+    }
+    best
 }
 
 /// Which simplex vertices support the nearest point.
@@ -222,6 +264,17 @@ fn best_of<const M: usize>(candidates: [(V, Kept); M]) -> (V, Kept) {
 
 fn nearest_on_tetrahedron(s: &Simplex) -> (V, Kept) {
     let faces: [[u8; 4]; 4] = [[0, 1, 2, 3], [0, 1, 3, 2], [0, 2, 3, 1], [1, 2, 3, 0]];
+    let (ab, ac, ad) = (s[1] - s[0], s[2] - s[0], s[3] - s[0]);
+    let volume = ab.dot(&ac.cross(&ad));
+    let scale = libm::sqrtf(ab.norm_squared() * ac.norm_squared() * ad.norm_squared());
+    let solid = volume.abs() > FLAT * scale;
+    if !solid {
+        // A flat tetrahedron (support points of a curved surface bunch up) cannot enclose the
+        // origin in any way f32 sign tests can trust: keep its best face and go on. Were the
+        // sets overlapping, the loop ends at its cap with a `v` whose gap is ≤ 0, so this can
+        // only cost iterations, never call an overlapping pair apart.
+        return best_of(faces.map(|[i, j, k, _]| nearest_on_triangle(s, [i, j, k])));
+    }
     let mut best: Option<(V, Kept)> = None;
     let mut inside = true;
     for [i, j, k, opposite] in faces {

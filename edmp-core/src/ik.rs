@@ -5,10 +5,11 @@
 //! of starts: the preferred configuration first, then a Halton sequence over the soft limits,
 //! so the answer is deterministic and the work is bounded (`starts × iterations` FK and 6×6
 //! solves at most). Each iterate is projected back into the limits; a converged solution is
-//! kept only if the exact checker finds it free in the scene. Of the solutions found, the one
+//! kept only if the exact checker finds it free in the scene (by default PyBullet's rule for
+//! valid ends, `checker::END_MARGIN`). Of the solutions found, the one
 //! nearest the preferred configuration (Euclidean, joint space) wins.
 
-use crate::checker::{CheckConfig, check_state};
+use crate::checker::{CheckConfig, END_MARGIN, check_end};
 use crate::error::Error;
 use crate::kinematics::{Joints, Pose, forward};
 use crate::robot::{JOINTS, PANDA};
@@ -30,6 +31,9 @@ pub struct IkConfig {
     pub rotation_tolerance: f32,
     /// Damping λ of `Jᵀ(JJᵀ + λ²I)⁻¹`.
     pub damping: f32,
+    /// Clearance from obstacles a solution must keep (metres): [`END_MARGIN`], PyBullet's own
+    /// rule for valid ends, by default; generators that want roomier problems ask for more.
+    pub clearance: f32,
 }
 
 impl Default for IkConfig {
@@ -41,6 +45,7 @@ impl Default for IkConfig {
             position_tolerance: 1e-4,
             rotation_tolerance: 1e-3,
             damping: 0.02,
+            clearance: END_MARGIN,
         }
     }
 }
@@ -195,6 +200,8 @@ pub fn solve<const N: usize>(
         && config.max_solutions > 0
         && config.damping.is_finite()
         && config.damping >= 0.0
+        && config.clearance.is_finite()
+        && config.clearance >= 0.0
         && config.position_tolerance > 0.0
         && config.rotation_tolerance > 0.0;
     if !sane {
@@ -203,7 +210,10 @@ pub fn solve<const N: usize>(
     if !valid_target(target) || !preferred.iter().all(|x| x.is_finite()) {
         return Err(IkError::BadInput);
     }
-    let check = CheckConfig::default();
+    let check = CheckConfig {
+        end_margin: config.clearance,
+        ..CheckConfig::default()
+    };
     let mut best: Option<(f32, IkSolution)> = None;
     let (mut found, mut tried) = (0u16, 0u16);
     for n in 0..config.starts {
@@ -211,7 +221,7 @@ pub fn solve<const N: usize>(
         let Ok(Some(solution)) = descend(target, start(n, preferred), config) else {
             continue;
         };
-        if !matches!(check_state(scene, &solution.joints, &check), Ok(None)) {
+        if !matches!(check_end(scene, &solution.joints, &check), Ok(None)) {
             continue;
         }
         let distance: f32 = solution

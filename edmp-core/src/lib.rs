@@ -24,6 +24,7 @@ pub mod cost;
 pub mod error;
 pub mod geometry;
 pub mod gjk;
+pub mod global;
 pub mod guidance;
 pub mod guides;
 pub mod ik;
@@ -33,6 +34,7 @@ pub mod prior;
 pub mod rng;
 pub mod robot;
 pub mod scene;
+pub mod search;
 #[cfg(feature = "serde")]
 pub mod wire;
 

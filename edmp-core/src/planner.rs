@@ -2,15 +2,20 @@
 //! step let every row follow its guide, then judge every candidate with the exact checker and
 //! keep the free one with the lowest swept volume.
 //!
+//! When no candidate is free, the bounded global stage ([`crate::global`]) searches for a
+//! path and hands it back to the prior.
+//!
 //! Fixed work: the number of network forwards and cost gradients is set by the sampler, the
 //! guidance schedule and `B`, never by the scene's luck; the checker's states are bounded by
 //! the path length (at most `MAX_STEPS_PER_SEGMENT` per segment, each candidate checked at
-//! most twice: once to its first contact, once in full when no candidate is free).
+//! most twice: once to its first contact, once in full when no candidate is free). The global
+//! stage adds a bounded amount on top ([`crate::global`] states it).
 
 use crate::checker::{CheckConfig, check_trajectory};
 use crate::cost::{CostConfig, CostKind, trajectory_cost};
 use crate::error::Error;
 use crate::geometry::{BoxFrame, CylinderBox, Inflation};
+use crate::global::{GlobalConfig, SearchReport, Stage, rescue};
 use crate::guidance::guide_step;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
@@ -20,6 +25,7 @@ use crate::prior::{
 use crate::rng::Rng;
 use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
+use crate::search::SearchSpace;
 
 /// When guidance runs and how often.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,6 +83,8 @@ pub struct PlanConfig {
     pub frame: BoxFrame,
     /// The exact checker's settings for the final judgement.
     pub check: CheckConfig,
+    /// The global stage when no candidate is free (`None`: EDMP alone, as the paper).
+    pub global: Option<GlobalConfig>,
 }
 
 /// One candidate's verdict.
@@ -104,6 +112,11 @@ pub struct Plan<const B: usize> {
     /// Index of the chosen candidate: the free one with the lowest swept volume (lowest index on
     /// ties), or, if none is free, the one with the fewest colliding states (then swept volume).
     pub best: usize,
+    /// Which stage produced the chosen candidate. After the global stage, `paths` are its
+    /// reseeded candidates, and with [`Stage::Search`] row `best` holds the search path.
+    pub stage: Stage,
+    /// What the global stage's search did, when it ran.
+    pub search: Option<SearchReport>,
 }
 
 /// Denoising steps of the shipped configuration ([`PlanConfig::DEFAULT`]).
@@ -135,6 +148,7 @@ impl PlanConfig {
         cylinder: CylinderBox::Enclosing,
         frame: BoxFrame::Obstacle,
         check: CheckConfig::DEFAULT,
+        global: Some(GlobalConfig::DEFAULT),
     };
 }
 
@@ -164,38 +178,45 @@ impl<const B: usize> Plan<B> {
             eat(verdict.colliding_states);
         }
         eat(self.best as u32);
+        eat(self.stage as u32);
         hash
     }
 }
 
-/// Working memory of the planner for `B` rows (gradients and noise predictions).
-#[derive(Clone, Debug)]
-pub struct Workspace<const B: usize> {
-    eps: [Path; B],
-    grads: [Path; B],
+/// Nodes per tree of the global stage's search in the default [`Workspace`].
+pub const DEFAULT_SEARCH_NODES: usize = 512;
+
+/// Working memory of the planner for `B` rows (gradients and noise predictions) and of the
+/// global stage's search (`CAP` nodes per tree).
+#[derive(Debug)]
+pub struct Workspace<const B: usize, const CAP: usize = DEFAULT_SEARCH_NODES> {
+    pub(crate) eps: [Path; B],
+    pub(crate) grads: [Path; B],
+    pub(crate) search: SearchSpace<CAP>,
 }
 
-impl<const B: usize> Default for Workspace<B> {
+impl<const B: usize, const CAP: usize> Default for Workspace<B, CAP> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const B: usize> Workspace<B> {
+impl<const B: usize, const CAP: usize> Workspace<B, CAP> {
     /// Zeroed working memory (`const`: it can live in a `static`).
     pub const fn new() -> Self {
         Self {
             eps: [[[0.0; JOINTS]; HORIZON]; B],
             grads: [[[0.0; JOINTS]; HORIZON]; B],
+            search: SearchSpace::new(),
         }
     }
 }
 
 /// Plans from `start` to `goal` in `scene` with `B` rows over `guides` (`B` a multiple of
 /// `guides.len()`), drawing every random number from `rng`: the same inputs give the same bits.
-/// [`denoise`] then [`select`].
+/// [`denoise`] then [`select`], then [`finish`].
 #[allow(clippy::too_many_arguments)]
-pub fn plan<const B: usize, const N: usize, const C: usize>(
+pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     scene: &Scene<N>,
     start: &Joints<f32>,
     goal: &Joints<f32>,
@@ -203,16 +224,39 @@ pub fn plan<const B: usize, const N: usize, const C: usize>(
     config: &PlanConfig,
     rng: &mut Rng,
     scratch: &mut Scratch<C>,
-    work: &mut Workspace<B>,
+    work: &mut Workspace<B, CAP>,
 ) -> Result<Plan<B>, Error> {
     let mut paths = [[[0.0f32; JOINTS]; HORIZON]; B];
     denoise(scene, start, goal, guides, config, rng, scratch, work, &mut paths)?;
-    select(scene, start, goal, config, paths)
+    let first = select(scene, start, goal, config, paths)?;
+    finish(scene, start, goal, guides, config, rng, scratch, work, first)
+}
+
+/// After [`select`]: a plan with a free candidate is done; otherwise the global stage runs
+/// when `config.global` asks for it ([`crate::global::rescue`]).
+#[allow(clippy::too_many_arguments)]
+pub fn finish<const B: usize, const N: usize, const C: usize, const CAP: usize>(
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    rng: &mut Rng,
+    scratch: &mut Scratch<C>,
+    work: &mut Workspace<B, CAP>,
+    first: Plan<B>,
+) -> Result<Plan<B>, Error> {
+    match &config.global {
+        Some(global) if !first.is_free() => {
+            rescue(scene, start, goal, guides, config, global, rng, scratch, work, first)
+        }
+        _ => Ok(first),
+    }
 }
 
 /// The guided reverse diffusion: `paths` end as the `B` candidates (not yet clamped or judged).
 #[allow(clippy::too_many_arguments)]
-pub fn denoise<const B: usize, const N: usize, const C: usize>(
+pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     scene: &Scene<N>,
     start: &Joints<f32>,
     goal: &Joints<f32>,
@@ -220,7 +264,7 @@ pub fn denoise<const B: usize, const N: usize, const C: usize>(
     config: &PlanConfig,
     rng: &mut Rng,
     scratch: &mut Scratch<C>,
-    work: &mut Workspace<B>,
+    work: &mut Workspace<B, CAP>,
     paths: &mut [Path; B],
 ) -> Result<(), Error> {
     config.sampler.validate()?;
@@ -330,7 +374,18 @@ pub fn select<const B: usize, const N: usize>(
                 .then(a.cmp(&b))
         })
         .unwrap_or(0);
-    Ok(Plan { paths, verdicts, best })
+    let stage = if verdicts.get(best).is_some_and(|v| v.free) {
+        Stage::Diffusion
+    } else {
+        Stage::None
+    };
+    Ok(Plan {
+        paths,
+        verdicts,
+        best,
+        stage,
+        search: None,
+    })
 }
 
 #[cfg(test)]
@@ -362,6 +417,7 @@ mod tests {
             cylinder: CylinderBox::Enclosing,
             frame: BoxFrame::Obstacle,
             check: CheckConfig::default(),
+            global: None,
         }
     }
 

@@ -105,6 +105,14 @@ pub(crate) struct Record {
     pub(crate) roughness: Option<Roughness>,
     /// The guide whose candidate was returned (EDMP).
     pub(crate) guide: Option<u8>,
+    /// The stage that produced the returned path (EDMP: `diffusion`, `reseeded`, `search` or
+    /// `none`).
+    #[serde(default)]
+    pub(crate) stage: Option<String>,
+    /// Milliseconds in the global stage (EDMP; 0 when every first-stage candidate collided
+    /// and no global stage was asked for, or when one was free).
+    #[serde(default)]
+    pub(crate) global_ms: Option<f64>,
     /// Every candidate's verdict (EDMP).
     pub(crate) candidates: Vec<Candidate>,
     /// Mean pairwise cosine similarity of the ensemble's candidates (EDMP; lower: more diverse).
@@ -168,10 +176,12 @@ fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
         seed: args.seed,
         serial: args.serial,
         status: if plan.is_free() { "success" } else { "collision" }.to_owned(),
-        time_ms: planned.ik_ms + planned.denoise_ms + planned.select_ms,
+        time_ms: planned.total_ms(),
         path_length: Some(path_length(best)),
         roughness: Some(roughness(best)),
         guide: Some(guides[plan.best / per_guide].id),
+        stage: Some(plan.stage.name().to_owned()),
+        global_ms: Some(planned.global_ms),
         candidates,
         acsm: acsm(&batch),
         waypoints: best.to_vec(),
@@ -219,6 +229,8 @@ fn run_rrt(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
         path_length: (!waypoints.is_empty()).then(|| path_length(&waypoints)),
         roughness: (!waypoints.is_empty()).then(|| roughness(&waypoints)),
         guide: None,
+        stage: None,
+        global_ms: None,
         candidates: Vec::new(),
         acsm: None,
         waypoints,
@@ -329,6 +341,40 @@ fn summary(label: &str, records: &[Record]) -> String {
     }
     out += &table_row("all", &records.iter().collect::<Vec<_>>());
     out.push('\n');
+    out += &stage_table(records);
+    out
+}
+
+/// Which stage solved each family's problems (EDMP runs; empty for RRT-Connect).
+fn stage_table(records: &[Record]) -> String {
+    const STAGES: [&str; 4] = ["diffusion", "reseeded", "search", "none"];
+    if records.iter().all(|r| r.stage.is_none()) {
+        return String::new();
+    }
+    let mut out = "\n| family | diffusion | reseeded | search | none | median global-stage ms (when it ran) |\n|---|---|---|---|---|---|\n".to_owned();
+    let mut names = families(records);
+    names.push("all".to_owned());
+    for family in names {
+        let rows: Vec<&Record> = records
+            .iter()
+            .filter(|r| family == "all" || r.family == family)
+            .collect();
+        let count = |stage: &str| rows.iter().filter(|r| r.stage.as_deref() == Some(stage)).count();
+        let mut ran: Vec<f64> = rows
+            .iter()
+            .filter(|r| matches!(r.stage.as_deref(), Some("reseeded" | "search" | "none")))
+            .filter_map(|r| r.global_ms)
+            .filter(|ms| *ms > 0.0)
+            .collect();
+        ran.sort_by(f64::total_cmp);
+        let median = if ran.is_empty() {
+            "–".to_owned()
+        } else {
+            format!("{:.1}", percentile(&ran, 0.5))
+        };
+        let counts: Vec<String> = STAGES.iter().map(|s| count(s).to_string()).collect();
+        out += &format!("| {family} | {} | {median} |\n", counts.join(" | "));
+    }
     out
 }
 

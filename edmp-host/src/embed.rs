@@ -123,7 +123,7 @@ pub(crate) fn plan_like_firmware(problem: &Problem<MAX_OBSTACLES>) -> Result<Pla
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<ROWS>::new());
     let mut rng = Rng::new(problem.seed);
-    plan::<ROWS, MAX_OBSTACLES, 4>(
+    plan::<ROWS, MAX_OBSTACLES, 4, { edmp_core::planner::DEFAULT_SEARCH_NODES }>(
         &scene,
         &problem.start,
         &problem.goal,

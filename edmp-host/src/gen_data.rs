@@ -159,6 +159,16 @@ mod tests {
     use super::*;
     use edmp_core::robot::PANDA;
 
+    /// The unseen suite measures generalization only if training never draws its kinds.
+    #[test]
+    fn training_never_draws_an_unseen_kind() {
+        for seed in 0..600u64 {
+            let family = family_of(seed);
+            assert!(Family::ALL.contains(&family), "seed {seed}: {family:?}");
+            assert!(!Family::UNSEEN.contains(&family), "seed {seed}: {family:?}");
+        }
+    }
+
     #[test]
     fn npy_header_is_what_numpy_expects() {
         let path = std::env::temp_dir().join(format!("edmp-npy-{}.npy", std::process::id()));

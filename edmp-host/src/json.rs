@@ -1,7 +1,7 @@
 //! The `edmp-scene/1` format (`shared/spec/formats.md`): parsing with errors that name the
 //! offending field by its JSON path, e.g. `obstacles[3].quaternion: norm 0.71, expected 1`.
 
-use edmp_core::checker::{CheckConfig, Contact, check_state};
+use edmp_core::checker::{CheckConfig, Contact, check_end};
 use edmp_core::ik::{IkConfig, solve};
 use edmp_core::kinematics::{Joints, Pose};
 use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS, PANDA};
@@ -251,7 +251,7 @@ pub(crate) fn parse_problem(text: &str) -> Result<Problem, InputError> {
     let (start, sp) = field(map, "", "start")?;
     let start = joints(start, &sp)?;
     if let Some(c) =
-        check_state(&scene, &start, &CheckConfig::default()).map_err(|e| InputError::at(&sp, e.to_string()))?
+        check_end(&scene, &start, &CheckConfig::default()).map_err(|e| InputError::at(&sp, e.to_string()))?
     {
         return Err(InputError::at(&sp, format!("in collision: {}", describe(c))));
     }
@@ -262,7 +262,7 @@ pub(crate) fn parse_problem(text: &str) -> Result<Problem, InputError> {
             let path = format!("{gp}.joints");
             let q = joints(q, &path)?;
             if let Some(c) =
-                check_state(&scene, &q, &CheckConfig::default()).map_err(|e| InputError::at(&path, e.to_string()))?
+                check_end(&scene, &q, &CheckConfig::default()).map_err(|e| InputError::at(&path, e.to_string()))?
             {
                 return Err(InputError::at(&path, format!("in collision: {}", describe(c))));
             }

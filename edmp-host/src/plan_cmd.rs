@@ -10,7 +10,7 @@ use edmp_core::geometry::{BoxFrame, Inflation};
 use edmp_core::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
-    PlanConfig, Workspace, denoise, select,
+    PlanConfig, Workspace, denoise, finish, select,
 };
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
@@ -69,6 +69,10 @@ pub(crate) struct Tuning {
     /// EDMP's original sampler and guidance: 255 ancestral steps, guidance on even t ≥ 6.
     #[arg(long)]
     ancestral: bool,
+    /// Without the global stage: when no candidate is free, return the least colliding one
+    /// (EDMP alone, as the paper) instead of searching and reseeding the prior.
+    #[arg(long)]
+    no_global: bool,
 }
 
 impl Tuning {
@@ -94,6 +98,11 @@ impl Tuning {
                 BoxFrame::World
             } else {
                 BoxFrame::Obstacle
+            },
+            global: if self.no_global {
+                None
+            } else {
+                PlanConfig::DEFAULT.global
             },
             ..PlanConfig::DEFAULT
         };
@@ -126,6 +135,11 @@ impl Tuning {
         } else {
             "no step limit".to_owned()
         };
+        let boxes = if self.no_global {
+            format!("{boxes}, no global stage")
+        } else {
+            boxes.to_owned()
+        };
         if self.ancestral {
             format!(
                 "ancestral K = 255, guidance on even t, {} refinement steps, {limit}{boxes}",
@@ -144,10 +158,18 @@ impl Tuning {
 pub(crate) struct Planned {
     /// Candidates, verdicts, the winner.
     pub(crate) plan: Plan<ROWS>,
-    /// Milliseconds in IK, in the guided denoising, in the selection.
+    /// Milliseconds in IK, in the guided denoising, in the selection, in the global stage.
     pub(crate) ik_ms: f64,
     pub(crate) denoise_ms: f64,
     pub(crate) select_ms: f64,
+    pub(crate) global_ms: f64,
+}
+
+impl Planned {
+    /// Planning time in all, milliseconds.
+    pub(crate) fn total_ms(&self) -> f64 {
+        self.ik_ms + self.denoise_ms + self.select_ms + self.global_ms
+    }
 }
 
 /// Plans a parsed problem: IK for a pose goal, then the core planner with `ROWS` rows.
@@ -182,11 +204,26 @@ pub(crate) fn plan_problem(
     let plan = select(&problem.scene, &problem.start, &goal, config, *paths)
         .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
+    let global_began = Instant::now();
+    let plan = finish(
+        &problem.scene,
+        &problem.start,
+        &goal,
+        guides,
+        config,
+        &mut rng,
+        &mut scratch,
+        &mut work,
+        plan,
+    )
+    .map_err(|e| Failure::Input(format!("planner: {e}")))?;
+    let global_ms = global_began.elapsed().as_secs_f64() * 1e3;
     Ok(Planned {
         plan,
         ik_ms,
         denoise_ms,
         select_ms,
+        global_ms,
     })
 }
 
@@ -239,6 +276,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         "status": status,
         "waypoints": best.iter().map(|q| q.to_vec()).collect::<Vec<_>>(),
         "guide": guide_of(plan.best),
+        "stage": plan.stage.name(),
         "costs": {"swept_volume": plan.verdicts[plan.best].swept, "intersection_volume": intersection},
         "seed": args.seed,
         "timing_ms": {
@@ -246,6 +284,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
             "ik": planned.ik_ms,
             "denoise": planned.denoise_ms,
             "select": planned.select_ms,
+            "global": planned.global_ms,
         },
     });
     if args.candidates {

@@ -8,8 +8,9 @@
 //! only if the whole trajectory stays free). Deterministic for a seed.
 
 use core::time::Duration;
-use edmp_core::checker::{CheckConfig, check_state, check_trajectory};
+use edmp_core::checker::{CheckConfig, check_end, check_segment, check_trajectory};
 use edmp_core::kinematics::Joints;
+use edmp_core::prior::HORIZON;
 use edmp_core::rng::Rng;
 use edmp_core::robot::PANDA;
 use edmp_core::scene::Scene;
@@ -120,20 +121,23 @@ fn steer(from: &Joints<f32>, to: &Joints<f32>, step: f32) -> Joints<f32> {
 struct Planner<'a, const N: usize> {
     scene: &'a Scene<N>,
     check: CheckConfig,
+    /// The problem's start and goal: states near them keep the checker's end margin.
+    ends: [Joints<f32>; 2],
 }
 
 impl<const N: usize> Planner<'_, N> {
-    fn free(&self, q: &Joints<f32>) -> Result<bool, RrtError> {
+    /// A valid end (`spec/formats.md`): inside the limits and free by PyBullet's own rule.
+    fn valid_end(&self, q: &Joints<f32>) -> Result<bool, RrtError> {
         let ok = PANDA.within_soft_limits(q, 0.0);
         Ok(ok
-            && check_state(self.scene, q, &self.check)
+            && check_end(self.scene, q, &self.check)
                 .map_err(RrtError::Checker)?
                 .is_none())
     }
 
     fn edge_free(&self, a: &Joints<f32>, b: &Joints<f32>) -> Result<bool, RrtError> {
-        let report = check_trajectory(self.scene, &[*a, *b], &self.check, true).map_err(RrtError::Checker)?;
-        Ok(report.is_free())
+        let [start, goal] = &self.ends;
+        check_segment(self.scene, a, b, [start, goal], &self.check).map_err(RrtError::Checker)
     }
 
     /// One step of `tree` towards `target`; the new node's index if the edge is free.
@@ -211,11 +215,12 @@ pub(crate) fn plan<const H: usize, const N: usize>(
     let planner = Planner {
         scene,
         check: CheckConfig::default(),
+        ends: [*start, *goal],
     };
-    if !planner.free(start)? {
+    if !planner.valid_end(start)? {
         return Err(RrtError::InvalidStart);
     }
-    if !planner.free(goal)? {
+    if !planner.valid_end(goal)? {
         return Err(RrtError::InvalidGoal);
     }
     let mut rng = Rng::new(seed);
@@ -249,11 +254,22 @@ pub(crate) fn plan<const H: usize, const N: usize>(
     let mut path = raw.unwrap_or_default();
     planner.shortcut(&mut path, config.shortcuts, &mut rng)?;
     let mut waypoints = resample::<H>(&path);
-    if !check_trajectory(scene, &waypoints, &planner.check, true)
-        .map_err(RrtError::Checker)?
-        .is_free()
-    {
-        return Err(RrtError::Resample);
+    let free = |w: &[Joints<f32>; H]| -> Result<bool, RrtError> {
+        Ok(check_trajectory(scene, w, &planner.check, true)
+            .map_err(RrtError::Checker)?
+            .is_free())
+    };
+    if !free(&waypoints)? {
+        // Even spacing cut a corner: keep every vertex of the shortcut path instead (the
+        // core's resampling, for the core's horizon).
+        let through = edmp_core::search::resample_through_vertices(&path).filter(|_| H == HORIZON);
+        let Some(through) = through else {
+            return Err(RrtError::Resample);
+        };
+        waypoints = core::array::from_fn(|i| through.get(i).copied().unwrap_or(*goal));
+        if !free(&waypoints)? {
+            return Err(RrtError::Resample);
+        }
     }
     for _ in 0..config.smoothing {
         let mut smoothed = waypoints;
@@ -261,10 +277,7 @@ pub(crate) fn plan<const H: usize, const N: usize>(
             smoothed[w] =
                 core::array::from_fn(|j| 0.5 * waypoints[w][j] + 0.25 * (waypoints[w - 1][j] + waypoints[w + 1][j]));
         }
-        if !check_trajectory(scene, &smoothed, &planner.check, true)
-            .map_err(RrtError::Checker)?
-            .is_free()
-        {
+        if !free(&smoothed)? {
             break;
         }
         waypoints = smoothed;
@@ -337,7 +350,11 @@ mod tests {
     fn invalid_ends_are_reported() {
         let scene = wall_scene();
         let inside = [0.0, 0.3, 0.0, -1.2, 0.0, 1.5, 0.785];
-        assert!(check_state(&scene, &inside, &CheckConfig::default()).unwrap().is_some());
+        assert!(
+            edmp_core::checker::check_state(&scene, &inside, &CheckConfig::default())
+                .unwrap()
+                .is_some()
+        );
         assert_eq!(
             plan::<50, 8>(&scene, &inside, &RIGHT, &RrtConfig::default(), 1).err(),
             Some(RrtError::InvalidStart)

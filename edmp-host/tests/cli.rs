@@ -210,7 +210,7 @@ const BAD_PLAN_INPUTS: &[(&str, &str, &str)] = &[
     ),
     (
         "goal in collision",
-        r#"{"format": "edmp-scene/1", "obstacles": [{"type": "sphere", "center": [0.554,0,0.3], "radius": 0.05}], "start": [0.8,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
+        r#"{"format": "edmp-scene/1", "obstacles": [{"type": "sphere", "center": [0.554,0,0.3], "radius": 0.08}], "start": [0.8,0,0,-2,0,2,0], "goal": {"joints": [0,0,0,-2,0,2,0]}}"#,
         "goal.joints: in collision",
     ),
     (
@@ -357,7 +357,7 @@ fn every_example_plans_a_collision_free_path_from_its_start_to_its_goal() {
 
 #[test]
 fn plan_exits_1_and_still_writes_the_least_colliding_plan_when_no_candidate_is_free() {
-    // Two unguided denoising steps: the prior's paths run through the wall.
+    // Two unguided denoising steps and no global stage: the prior's paths run through the wall.
     let dir = std::env::temp_dir().join(format!("edmp-plan-1-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("plan.json");
@@ -370,6 +370,7 @@ fn plan_exits_1_and_still_writes_the_least_colliding_plan_when_no_candidate_is_f
         "0",
         "--refine-steps",
         "0",
+        "--no-global",
         "-o",
         path.to_str().unwrap(),
     ]);
@@ -378,6 +379,27 @@ fn plan_exits_1_and_still_writes_the_least_colliding_plan_when_no_candidate_is_f
     let plan: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     assert_eq!(plan["status"], "collision");
     assert_eq!(plan["waypoints"].as_array().unwrap().len(), 50);
+    assert_eq!(plan["stage"], "none");
+    // With the global stage, the same first stage is rescued: a search path, reshaped by the prior.
+    let out = edmp_host(&[
+        "plan",
+        "examples/wall.json",
+        "--steps",
+        "2",
+        "--gradient-steps",
+        "0",
+        "--refine-steps",
+        "0",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let plan: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert!(
+        plan["stage"] == "reseeded" || plan["stage"] == "search",
+        "{}",
+        plan["stage"]
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -7,7 +7,9 @@
 use edmp_core::checker::CheckConfig;
 use edmp_core::geometry::{BoxFrame, CylinderBox};
 use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::global::GlobalConfig;
 use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
+use edmp_core::search::SearchConfig;
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
@@ -65,6 +67,23 @@ fuzz_target!(|data: &[u8]| {
         cylinder: CylinderBox::Enclosing,
         frame: if r.byte() & 1 == 0 { BoxFrame::Obstacle } else { BoxFrame::World },
         check: CheckConfig::default(),
+        // The global stage with a small, fuzzed budget and noise level (it runs only when no
+        // candidate is free, which most fuzzed scenes reach).
+        global: if r.byte() & 1 == 0 {
+            None
+        } else {
+            Some(GlobalConfig {
+                search: SearchConfig {
+                    max_iterations: u32::from(r.byte()),
+                    max_nodes: u16::from(r.byte()).max(1),
+                    ..SearchConfig::DEFAULT
+                },
+                noise_step: u16::from(r.byte()),
+                steps: u16::from(r.byte() % 4),
+                per_step: r.byte() % 3,
+                refine: r.byte() % 3,
+            })
+        },
     };
     let guides = &EDMP_GUIDES[..[1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)]];
     let mut scratch = Box::new(Scratch::<4>::new());

@@ -185,6 +185,34 @@ impl Sampler {
     }
 }
 
+impl Step {
+    /// The `j`-th step of a strided walk of `steps` steps that starts at diffusion step `from`
+    /// rather than at `STEPS`: t_j = from − ⌊j·from/steps⌋, landing on 0 after the last. The
+    /// strided rule applies to any such step ([`Sampler::update`] with `Sampler::Strided`).
+    pub fn partial(from: u16, steps: u16, j: usize) -> Self {
+        let at = |j: usize| -> u16 {
+            let (from, k) = (usize::from(from), usize::from(steps.max(1)));
+            if j >= k { 0 } else { (from - j * from / k) as u16 }
+        };
+        Self {
+            t: at(j),
+            prev: at(j + 1),
+        }
+    }
+}
+
+/// The forward process q(x_t | x_0): `x ← √ᾱ_t·x + √(1−ᾱ_t)·ε` (standard normals from `rng`,
+/// waypoint-major), then the ends written in: how a trajectory found elsewhere is handed to the
+/// prior at an intermediate step (SDEdit), to be denoised from there.
+pub fn diffuse(x: &mut Path, t: u16, rng: &mut Rng, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
+    let i = table_index(t);
+    let (a, n) = (generated::SQRT_ALPHA_BAR[i], generated::SQRT_ONE_MINUS_ALPHA_BAR[i]);
+    for v in x.iter_mut().flatten() {
+        *v = a * *v + n * rng.normal_f32();
+    }
+    inpaint(x, start, goal);
+}
+
 /// Index of step `t` in the schedule tables; steps outside 1 ..= `STEPS` (a hand-made [`Step`])
 /// take the nearest end instead of panicking.
 fn table_index(t: u16) -> usize {

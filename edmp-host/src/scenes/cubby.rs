@@ -75,5 +75,9 @@ pub(super) fn generate(rng: &mut Rng, merged: bool) -> Environment {
             }
         })
         .collect();
-    Environment { prims, regions }
+    Environment {
+        prims,
+        regions,
+        goals: Vec::new(),
+    }
 }

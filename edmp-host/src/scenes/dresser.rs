@@ -187,5 +187,9 @@ pub(super) fn generate(rng: &mut Rng) -> Environment {
             approach: Approach::Down { yaw },
         })
         .collect();
-    Environment { prims, regions }
+    Environment {
+        prims,
+        regions,
+        goals: Vec::new(),
+    }
 }

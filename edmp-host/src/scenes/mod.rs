@@ -5,10 +5,17 @@
 //! problem is then a start and a goal (task-oriented: both poses in those volumes; neutral
 //! start / neutral goal: one end near the robot's neutral configuration), each end solved to
 //! joints by the core's collision-checked IK, and accepted only when RRT-Connect connects them.
+//!
+//! Four more kinds (cage, window box, bookshelf, under table) are never drawn for training: they
+//! make the unseen suite, which measures how the prior generalizes.
 
+mod bookshelf;
+mod cage;
 mod cubby;
 mod dresser;
 mod tabletop;
+mod under_table;
+mod window_box;
 
 use edmp_core::checker::{CheckConfig, check_state};
 use edmp_core::ik::{IkConfig, solve};
@@ -19,7 +26,7 @@ use edmp_core::scene::{MAX_OBSTACLES, Obstacle, Scene};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use serde_json::{Value, json};
 
-/// The four MpiNets scene families.
+/// The four MpiNets scene families (the training families) and the four unseen kinds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum Family {
     /// Table with boxes and cylinders on it.
@@ -30,11 +37,22 @@ pub(crate) enum Family {
     MergedCubby,
     /// A dresser with drawers, two of them open.
     Dresser,
+    /// Unseen: a closed cage whose front is vertical bars; the goal inside, through a slot.
+    Cage,
+    /// Unseen: a closed box with a window in its front wall; the goal inside.
+    WindowBox,
+    /// Unseen: a bookshelf of 2-6 boards with cans and boxes; goals between boards.
+    Bookshelf,
+    /// Unseen: a table or shelf; the goal under its top, the start above or beside it.
+    UnderTable,
 }
 
 impl Family {
-    /// Every family, in suite order.
+    /// The training families, in suite order: the only ones `gen-data` draws.
     pub(crate) const ALL: [Family; 4] = [Family::Tabletop, Family::Cubby, Family::MergedCubby, Family::Dresser];
+
+    /// The kinds the prior never sees in training (the unseen suite), in suite order.
+    pub(crate) const UNSEEN: [Family; 4] = [Family::Cage, Family::WindowBox, Family::Bookshelf, Family::UnderTable];
 
     /// The name used in file names and JSON.
     pub(crate) fn name(self) -> &'static str {
@@ -43,6 +61,10 @@ impl Family {
             Family::Cubby => "cubby",
             Family::MergedCubby => "merged_cubby",
             Family::Dresser => "dresser",
+            Family::Cage => "cage",
+            Family::WindowBox => "window_box",
+            Family::Bookshelf => "bookshelf",
+            Family::UnderTable => "under_table",
         }
     }
 }
@@ -106,6 +128,133 @@ pub(crate) fn yaw_quaternion(yaw: f32) -> [f32; 4] {
     [(yaw * 0.5).cos(), 0.0, 0.0, (yaw * 0.5).sin()]
 }
 
+/// A structure's own frame for the unseen kinds: origin on the floor at the middle of its
+/// front, local x pointing away from the robot (into the structure), y to its left, z up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Frame {
+    origin: [f32; 2],
+    pub yaw: f32,
+}
+
+impl Frame {
+    /// In front of the robot, within its reach: the front's middle `distance` from the base on
+    /// a bearing of U(−bearing, bearing), the structure turned to face the base up to ±`jitter`.
+    pub(crate) fn facing(rng: &mut Rng, distance: [f32; 2], bearing: f32, jitter: f32) -> Frame {
+        let heading = rng.uniform_f32(-bearing, bearing);
+        let d = rng.uniform_f32(distance[0], distance[1]);
+        let yaw = heading + rng.uniform_f32(-jitter, jitter);
+        Frame {
+            origin: [d * heading.cos(), d * heading.sin()],
+            yaw,
+        }
+    }
+
+    /// A local point in the world.
+    pub(crate) fn point(&self, p: [f32; 3]) -> [f32; 3] {
+        let (s, c) = self.yaw.sin_cos();
+        [
+            self.origin[0] + c * p[0] - s * p[1],
+            self.origin[1] + s * p[0] + c * p[1],
+            p[2],
+        ]
+    }
+
+    /// The cuboid spanning local `lo` to `hi`, turned with the frame.
+    pub(crate) fn cuboid(&self, lo: [f32; 3], hi: [f32; 3]) -> Prim {
+        Prim::Cuboid {
+            center: self.point(core::array::from_fn(|i| (lo[i] + hi[i]) / 2.0)),
+            dims: core::array::from_fn(|i| hi[i] - lo[i]),
+            quaternion: yaw_quaternion(self.yaw),
+        }
+    }
+
+    /// An upright cylinder standing at local `(x, y, z)`.
+    pub(crate) fn cylinder(&self, foot: [f32; 3], radius: f32, height: f32) -> Prim {
+        Prim::Cylinder {
+            center: self.point([foot[0], foot[1], foot[2] + height / 2.0]),
+            radius,
+            height,
+            quaternion: yaw_quaternion(self.yaw),
+        }
+    }
+
+    /// The region spanning local `lo` to `hi`.
+    pub(crate) fn region(&self, lo: [f32; 3], hi: [f32; 3], approach: Approach) -> Region {
+        Region {
+            center: self.point(core::array::from_fn(|i| (lo[i] + hi[i]) / 2.0)),
+            half: core::array::from_fn(|i| (hi[i] - lo[i]) / 2.0),
+            yaw: self.yaw,
+            approach,
+        }
+    }
+
+    /// Horizontal distance from the robot's base to a local point (to drop unreachable regions).
+    pub(crate) fn reach_of(&self, p: [f32; 3]) -> f32 {
+        let w = self.point(p);
+        (w[0] * w[0] + w[1] * w[1]).sqrt()
+    }
+}
+
+/// Up to `count` cans (cylinders) and small boxes standing on the local rectangle
+/// `area` = [x range, y range] at height `z`, each at most `max_height` tall, inside the rectangle and 3 cm apart (bounding
+/// circles). Fewer are placed when the rectangle is crowded.
+pub(crate) fn clutter(
+    frame: &Frame,
+    rng: &mut Rng,
+    area: [[f32; 2]; 2],
+    z: f32,
+    max_height: f32,
+    count: usize,
+    out: &mut Vec<Prim>,
+) {
+    let [x, y] = area;
+    if max_height < 0.06 {
+        return;
+    }
+    let mut placed: Vec<([f32; 2], f32)> = Vec::new();
+    for _ in 0..10 * count {
+        if placed.len() >= count {
+            break;
+        }
+        let height = rng.uniform_f32(0.06, max_height);
+        let can = rng.unit_f32() < 0.5;
+        let (radius, dims, yaw) = if can {
+            let r = rng.uniform_f32(0.025, 0.045);
+            (r, [2.0 * r; 2], 0.0)
+        } else {
+            let d = [rng.uniform_f32(0.04, 0.12), rng.uniform_f32(0.03, 0.1)];
+            (
+                0.5 * (d[0] * d[0] + d[1] * d[1]).sqrt(),
+                d,
+                rng.uniform_f32(0.0, core::f32::consts::PI),
+            )
+        };
+        if x[1] - x[0] < 2.0 * radius || y[1] - y[0] < 2.0 * radius {
+            continue;
+        }
+        let c = [
+            rng.uniform_f32(x[0] + radius, x[1] - radius),
+            rng.uniform_f32(y[0] + radius, y[1] - radius),
+        ];
+        if placed
+            .iter()
+            .any(|(p, r)| ((c[0] - p[0]).powi(2) + (c[1] - p[1]).powi(2)).sqrt() < r + radius + 0.03)
+        {
+            continue;
+        }
+        placed.push((c, radius));
+        if can {
+            out.push(frame.cylinder([c[0], c[1], z], radius, height));
+        } else {
+            out.push(Prim::Cuboid {
+                center: frame.point([c[0], c[1], z + height / 2.0]),
+                dims: [dims[0], dims[1], height],
+                quaternion: yaw_quaternion(frame.yaw + yaw),
+            });
+        }
+    }
+}
+
 /// How the gripper faces in a region.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Approach {
@@ -115,6 +264,10 @@ pub(crate) enum Approach {
     Down { yaw: f32 },
     /// Horizontal, U(−π/4, π/4) from the +x axis turned by `yaw`; gripper x = −world z (cubbies).
     Horizontal { yaw: f32 },
+    /// Horizontal, U(−spread, spread) from the +x axis turned by `yaw`. `upright`: the fingers
+    /// open along world z (the hand's wide side vertical, to pass between vertical bars);
+    /// otherwise gripper x = −world z as in `Horizontal` (wide side horizontal, between boards).
+    Level { yaw: f32, spread: f32, upright: bool },
 }
 
 /// A box-shaped volume the gripper may be sent into.
@@ -155,6 +308,17 @@ impl Region {
                 let x = Vector3::new(0.0, 0.0, -1.0);
                 Matrix3::from_columns(&[x, z.cross(&x), z])
             }
+            Approach::Level { yaw, spread, upright } => {
+                let theta = yaw + rng.uniform_f32(-spread, spread);
+                let z = Vector3::new(theta.cos(), theta.sin(), 0.0);
+                if upright {
+                    let y = Vector3::new(0.0, 0.0, 1.0);
+                    Matrix3::from_columns(&[y.cross(&z), y, z])
+                } else {
+                    let x = Vector3::new(0.0, 0.0, -1.0);
+                    Matrix3::from_columns(&[x, z.cross(&x), z])
+                }
+            }
         };
         Pose { rotation, translation }
     }
@@ -166,6 +330,9 @@ pub(crate) struct Environment {
     pub prims: Vec<Prim>,
     /// Candidate regions; a task-oriented problem takes its ends from two of them.
     pub regions: Vec<Region>,
+    /// Goal regions (the unseen kinds): when not empty, posed goals come from here and
+    /// `regions` holds the task-oriented starts. Empty for the MpiNets families.
+    pub goals: Vec<Region>,
 }
 
 impl Environment {
@@ -220,6 +387,10 @@ pub(crate) fn environment(family: Family, rng: &mut Rng) -> Environment {
         Family::Cubby => cubby::generate(rng, false),
         Family::MergedCubby => cubby::generate(rng, true),
         Family::Dresser => dresser::generate(rng),
+        Family::Cage => cage::generate(rng),
+        Family::WindowBox => window_box::generate(rng),
+        Family::Bookshelf => bookshelf::generate(rng),
+        Family::UnderTable => under_table::generate(rng),
     }
 }
 
@@ -230,9 +401,12 @@ pub(crate) fn reach(
     rng: &mut Rng,
     attempts: u32,
 ) -> Option<(Joints<f32>, Pose<f32>)> {
+    // The planner's 2 mm rather than the valid-end rule: generated ends keep the room the
+    // committed suite was made with.
     let ik = IkConfig {
         starts: 16,
         max_solutions: 1,
+        clearance: edmp_core::checker::DEFAULT_MARGIN,
         ..IkConfig::default()
     };
     for _ in 0..attempts {
@@ -263,6 +437,9 @@ pub(crate) fn problem(family: Family, kind: Kind, seed: u64) -> Option<Problem> 
     let mut rng = Rng::new(seed);
     let env = environment(family, &mut rng);
     let scene = env.scene()?;
+    if !env.goals.is_empty() {
+        return targeted(family, kind, seed, env, scene, &mut rng);
+    }
     let n = env.regions.len() as u32;
     let first = rng.below(n) as usize;
     // Task-oriented ends come from different regions when there are several (cubby pockets,
@@ -302,6 +479,50 @@ pub(crate) fn problem(family: Family, kind: Kind, seed: u64) -> Option<Problem> 
     })
 }
 
+/// A problem of an environment with goal regions (the unseen kinds): the posed goal (or, for
+/// a neutral goal, the posed start) in a goal region, a task-oriented start in another region.
+fn targeted(
+    family: Family,
+    kind: Kind,
+    seed: u64,
+    env: Environment,
+    scene: Scene<MAX_OBSTACLES>,
+    rng: &mut Rng,
+) -> Option<Problem> {
+    let target = env.goals[rng.below(env.goals.len() as u32) as usize];
+    // A task-oriented start avoids the goal's own region when there is another one.
+    let others: Vec<&Region> = env.regions.iter().filter(|r| **r != target).collect();
+    let (start, goal, goal_pose) = match kind {
+        Kind::TaskOriented => {
+            let from = *others.get(rng.below(others.len().max(1) as u32) as usize)?;
+            let (s, _) = reach(&scene, from, rng, 20)?;
+            let (g, pose) = reach(&scene, &target, rng, 20)?;
+            (s, g, pose)
+        }
+        Kind::NeutralStart => {
+            let s = neutral(&scene, rng)?;
+            let (g, pose) = reach(&scene, &target, rng, 20)?;
+            (s, g, pose)
+        }
+        Kind::NeutralGoal => {
+            let (s, _) = reach(&scene, &target, rng, 20)?;
+            let g = neutral(&scene, rng)?;
+            let pose = *edmp_core::kinematics::forward(&g).ok()?.tcp();
+            (s, g, pose)
+        }
+    };
+    Some(Problem {
+        family,
+        kind,
+        seed,
+        env,
+        scene,
+        start,
+        goal,
+        goal_pose,
+    })
+}
+
 impl Problem {
     /// The problem as an `edmp-scene/1` document (joint goal), with the matching TCP pose goal
     /// and provenance under the optional `meta` field.
@@ -322,5 +543,186 @@ impl Problem {
                 },
             },
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Quaternion, UnitQuaternion};
+
+    /// Whether world point `p` is inside primitive `prim` (for the geometry tests).
+    fn inside(prim: &Prim, p: Vector3<f32>) -> bool {
+        let local = |center: [f32; 3], q: [f32; 4]| {
+            let turn = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+            turn.inverse() * (p - Vector3::from(center))
+        };
+        match *prim {
+            Prim::Cuboid {
+                center,
+                dims,
+                quaternion,
+            } => {
+                let l = local(center, quaternion);
+                (0..3).all(|i| l[i].abs() <= dims[i] / 2.0)
+            }
+            Prim::Cylinder {
+                center,
+                radius,
+                height,
+                quaternion,
+            } => {
+                let l = local(center, quaternion);
+                l.x * l.x + l.y * l.y <= radius * radius && l.z.abs() <= height / 2.0
+            }
+        }
+    }
+
+    /// A grid of world points over the local box `lo`..`hi` of `region`'s frame.
+    fn grid(region: &Region, lo: [f32; 3], hi: [f32; 3]) -> Vec<Vector3<f32>> {
+        let turn = Rotation3::from_axis_angle(&Vector3::z_axis(), region.yaw);
+        let steps = 8;
+        let mut out = Vec::new();
+        for i in 0..=steps {
+            for j in 0..=steps {
+                for k in 0..=steps {
+                    let f = |a: f32, b: f32, n: usize| a + (b - a) * n as f32 / steps as f32;
+                    let l = Vector3::new(f(lo[0], hi[0], i), f(lo[1], hi[1], j), f(lo[2], hi[2], k));
+                    out.push(Vector3::from(region.center) + turn * l);
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn training_families_are_not_unseen() {
+        for f in Family::ALL {
+            assert!(!Family::UNSEEN.contains(&f), "{f:?}");
+        }
+    }
+
+    #[test]
+    fn unseen_environments_are_valid_scenes_of_thick_primitives() {
+        for family in Family::UNSEEN {
+            for seed in 0..300u64 {
+                let env = environment(family, &mut Rng::new(seed));
+                assert!(env.prims.len() <= MAX_OBSTACLES, "{family:?} {seed}");
+                assert!(env.scene().is_some(), "{family:?} {seed}");
+                assert!(!env.goals.is_empty() && !env.regions.is_empty(), "{family:?} {seed}");
+                for p in &env.prims {
+                    let thin = match *p {
+                        Prim::Cuboid { dims, .. } => dims.iter().copied().fold(f32::INFINITY, f32::min),
+                        Prim::Cylinder { radius, height, .. } => (2.0 * radius).min(height),
+                    };
+                    assert!(thin >= 0.01, "{family:?} seed {seed}: {p:?}");
+                }
+                for r in env.regions.iter().chain(&env.goals) {
+                    assert!(r.half.iter().all(|&h| h > 0.0), "{family:?} seed {seed}: {r:?}");
+                }
+            }
+        }
+    }
+
+    /// The way into every goal region is open: the region itself and 30 cm in front of it
+    /// (towards the robot) touch no obstacle (the cage's slot, the window's hole, the space
+    /// under the table). Bookshelf gaps hold cans, so there only the 30 cm in front of the
+    /// shelf and its open front are checked.
+    #[test]
+    fn the_way_into_the_goals_is_open() {
+        for family in Family::UNSEEN {
+            for seed in 0..100u64 {
+                let env = environment(family, &mut Rng::new(seed));
+                for g in &env.goals {
+                    let h = g.half;
+                    let far = if family == Family::Bookshelf {
+                        -h[0] - 0.045
+                    } else {
+                        h[0]
+                    };
+                    for p in grid(g, [-h[0] - 0.3, -h[1], -h[2]], [far, h[1], h[2]]) {
+                        let hit = env.prims.iter().find(|prim| inside(prim, p));
+                        assert!(hit.is_none(), "{family:?} seed {seed}: {p:?} in {hit:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// Goals are really enclosed: a goal region of the cage and the window box is surrounded
+    /// by obstacles above, below, behind and on both sides (rays along ±y, ±z and +x from
+    /// its centre meet an obstacle within 1 m), and is under the table top for under-table.
+    #[test]
+    fn goals_are_inside_their_structure() {
+        for family in [Family::Cage, Family::WindowBox, Family::UnderTable] {
+            for seed in 0..100u64 {
+                let env = environment(family, &mut Rng::new(seed));
+                for g in &env.goals {
+                    let turn = Rotation3::from_axis_angle(&Vector3::z_axis(), g.yaw);
+                    let rays: &[[f32; 3]] = if family == Family::UnderTable {
+                        &[[0.0, 0.0, 1.0]]
+                    } else {
+                        &[
+                            [1.0, 0.0, 0.0],
+                            [0.0, 1.0, 0.0],
+                            [0.0, -1.0, 0.0],
+                            [0.0, 0.0, 1.0],
+                            [0.0, 0.0, -1.0],
+                        ]
+                    };
+                    for d in rays {
+                        let hit = (1..=200).any(|i| {
+                            let p = Vector3::from(g.center) + turn * (Vector3::from(*d) * (i as f32 * 0.005));
+                            env.prims.iter().any(|prim| inside(prim, p))
+                        });
+                        assert!(hit, "{family:?} seed {seed}: nothing along {d:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// The cage's front really is bars with 24-28 cm slots: every slot's middle line, from
+    /// floor to roof, is free, and a bar stands between neighbouring slots.
+    #[test]
+    fn cage_slots_are_between_bars() {
+        for seed in 0..100u64 {
+            let env = environment(Family::Cage, &mut Rng::new(seed));
+            let bars: Vec<&Prim> = env.prims[6..]
+                .iter()
+                .filter(|p| match p {
+                    Prim::Cylinder { radius, height, .. } => *radius <= 0.015 && *height >= 0.38,
+                    Prim::Cuboid { dims, .. } => dims[0] <= 0.03 && dims[1] <= 0.03 && dims[2] >= 0.38,
+                })
+                .collect();
+            assert_eq!(bars.len(), env.goals.len() + 1, "seed {seed}");
+            let centre = |p: &Prim| match *p {
+                Prim::Cuboid { center, .. } | Prim::Cylinder { center, .. } => Vector3::from(center),
+            };
+            for pair in bars.windows(2) {
+                let gap = (centre(pair[1]) - centre(pair[0])).norm();
+                assert!((0.255..=0.31).contains(&gap), "seed {seed}: bars {gap} m apart");
+            }
+        }
+    }
+
+    #[test]
+    fn unseen_goals_are_posed_in_a_goal_region() {
+        for family in Family::UNSEEN {
+            let mut found = 0;
+            for seed in 0..12u64 {
+                let kind = [Kind::TaskOriented, Kind::NeutralStart][(seed % 2) as usize];
+                let Some(p) = problem(family, kind, seed) else { continue };
+                found += 1;
+                let t = p.goal_pose.translation;
+                let within = p.env.goals.iter().any(|g| {
+                    let turn = Rotation3::from_axis_angle(&Vector3::z_axis(), -g.yaw);
+                    let l = turn * (t - Vector3::from(g.center));
+                    (0..3).all(|i| l[i].abs() <= g.half[i] + 0.01)
+                });
+                assert!(within, "{family:?} seed {seed}: goal at {t:?}");
+            }
+            assert!(found >= 3, "{family:?}: {found} problems of 12 seeds");
+        }
     }
 }

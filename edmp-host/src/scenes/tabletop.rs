@@ -129,5 +129,9 @@ pub(super) fn generate(rng: &mut Rng) -> Environment {
             })
         })
         .collect();
-    Environment { prims, regions }
+    Environment {
+        prims,
+        regions,
+        goals: Vec::new(),
+    }
 }

@@ -258,7 +258,7 @@ fn decode(bytes: &[u8]) -> Result<(Problem<OBSTACLES>, Scene<OBSTACLES>), Failur
 fn plan_scene(bytes: &[u8], scratch: &mut Scratch<1>, work: &mut Workspace<ROWS>) -> Result<Summary, Failure> {
     let (problem, scene) = decode(bytes)?;
     let mut rng = Rng::new(problem.seed);
-    let plan: Plan<ROWS> = plan::<ROWS, OBSTACLES, 1>(
+    let plan: Plan<ROWS> = plan::<ROWS, OBSTACLES, 1, { edmp_core::planner::DEFAULT_SEARCH_NODES }>(
         &scene,
         &problem.start,
         &problem.goal,

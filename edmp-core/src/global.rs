@@ -1,0 +1,191 @@
+//! The bounded global stage: what the planner does when no diffusion candidate is free.
+//!
+//! Local guidance cannot leave the basin the prior's sample fell into: a cage's slot, a box's
+//! window or a shelf's pocket may need a detour that no gradient points to. Then
+//! 1. [`crate::search`] (RRT-Connect over the exact checker, fixed capacity, bounded
+//!    iterations) finds a collision-free coarse path;
+//! 2. the prior makes trajectories of its own from it, SDEdit-style: every row gets the path
+//!    noised to an intermediate diffusion step ([`prior::diffuse`]) and is denoised from there
+//!    with its guide, then refined, exactly as the first stage does from pure noise;
+//! 3. the candidates are judged as any ([`select`]); only when none is free does the search
+//!    path itself win (it passed the checker edge by edge).
+//!
+//! Worst-case work, on top of the first stage: [`SearchConfig::max_oracle_calls`] segment
+//! checks, `steps` batched network forwards, `steps × per_step + refine` guidance steps over
+//! the batch, and one more selection. [`Plan::stage`] says which stage produced the winner.
+
+use crate::checker::check_segment;
+use crate::error::Error;
+use crate::guidance::guide_step;
+use crate::guides::Guide;
+use crate::kinematics::Joints;
+use crate::planner::{Plan, PlanConfig, Workspace, select};
+use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise};
+use crate::rng::Rng;
+use crate::scene::Scene;
+use crate::search::{SearchConfig, search};
+
+/// Settings of the global stage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GlobalConfig {
+    /// The search's budget.
+    pub search: SearchConfig,
+    /// Diffusion step the search path is noised to before the prior denoises it (1 ..=
+    /// `STEPS`): high enough that the prior reshapes it, low enough that it keeps its route.
+    pub noise_step: u16,
+    /// Strided denoising steps from `noise_step` down (1 ..= `noise_step`).
+    pub steps: u16,
+    /// Gradient steps of every guide after each of those denoising steps.
+    pub per_step: u8,
+    /// Refinement gradient steps at t = 1 afterwards.
+    pub refine: u8,
+}
+
+impl GlobalConfig {
+    /// The shipped setting (measured in the README and docs/benchmark.md).
+    pub const DEFAULT: Self = Self {
+        search: SearchConfig::DEFAULT,
+        noise_step: 50,
+        steps: 3,
+        per_step: 4,
+        refine: 24,
+    };
+
+    fn validate(&self) -> Result<(), Error> {
+        let ok = self.noise_step >= 1
+            && usize::from(self.noise_step) <= STEPS
+            && self.steps >= 1
+            && self.steps <= self.noise_step;
+        if ok { Ok(()) } else { Err(Error::BadParameter) }
+    }
+}
+
+/// Which stage produced the chosen trajectory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The guided diffusion from noise (EDMP's Algorithm 2).
+    Diffusion,
+    /// The prior and the guides, started from the search's path noised to an intermediate step.
+    Reseeded,
+    /// The search's own path (shortcut and resampled): no reseeded candidate was free.
+    Search,
+    /// Nothing was free; the least colliding first-stage candidate is returned.
+    None,
+}
+
+impl Stage {
+    /// A short name for plans and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Diffusion => "diffusion",
+            Self::Reseeded => "reseeded",
+            Self::Search => "search",
+            Self::None => "none",
+        }
+    }
+}
+
+/// What the search did, when it ran.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SearchReport {
+    /// Whether it found a path.
+    pub found: bool,
+    /// Tree nodes grown (both trees).
+    pub nodes: u32,
+    /// Sampling iterations.
+    pub iterations: u32,
+    /// Segment checks asked of the exact checker.
+    pub segment_checks: u32,
+}
+
+/// The global stage after a first stage whose candidates all collide (`first`); returns
+/// `first` unchanged (with the search's report) when the search finds nothing.
+#[allow(clippy::too_many_arguments)]
+pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    global: &GlobalConfig,
+    rng: &mut Rng,
+    scratch: &mut Scratch<C>,
+    work: &mut Workspace<B, CAP>,
+    first: Plan<B>,
+) -> Result<Plan<B>, Error> {
+    global.validate()?;
+    let mut calls = 0u32;
+    let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| {
+        calls = calls.saturating_add(1);
+        check_segment(scene, a, b, [start, goal], &config.check)
+    };
+    let found = search(start, goal, &global.search, &mut work.search, rng, &mut edge_free)?;
+    let report = |found: bool, nodes: usize, iterations: u32| SearchReport {
+        found,
+        nodes: nodes as u32,
+        iterations,
+        segment_checks: calls,
+    };
+    let Some(outcome) = found else {
+        return Ok(Plan {
+            search: Some(report(false, 0, global.search.max_iterations)),
+            ..first
+        });
+    };
+    let searched = report(true, outcome.nodes, outcome.iterations);
+    let mut paths = [outcome.path; B];
+    for x in paths.iter_mut() {
+        prior::diffuse(x, global.noise_step, rng, start, goal);
+    }
+    let strided = Sampler::Strided { steps: global.steps };
+    let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16| {
+        guide_step(
+            scene,
+            paths,
+            grads,
+            guides,
+            t,
+            config.step_limit,
+            config.cylinder,
+            config.frame,
+        )
+    };
+    for j in 0..usize::from(global.steps) {
+        let step = Step::partial(global.noise_step, global.steps, j);
+        predict_noise(&paths, &TimeEmbedding::new(step.t)?, scratch, &mut work.eps)?;
+        for (x, e) in paths.iter_mut().zip(&work.eps) {
+            strided.update(step, x, e, rng, start, goal);
+        }
+        if step.t >= 5 {
+            for _ in 0..global.per_step {
+                guide(&mut paths, &mut work.grads, step.t)?;
+            }
+        }
+    }
+    for _ in 0..global.refine {
+        guide(&mut paths, &mut work.grads, 1)?;
+    }
+    let mut reseeded = select(scene, start, goal, config, paths)?;
+    reseeded.search = Some(searched);
+    if reseeded.is_free() {
+        reseeded.stage = Stage::Reseeded;
+        return Ok(reseeded);
+    }
+    // The last resort: the search path itself, judged like a candidate, in the chosen row.
+    let own = select(scene, start, goal, config, [outcome.path])?;
+    if !own.is_free() {
+        // The search checked every segment with the same checker; this cannot happen, and a
+        // colliding path is never passed off as a success.
+        return Ok(Plan {
+            search: Some(searched),
+            ..first
+        });
+    }
+    let best = reseeded.best;
+    if let (Some(slot), Some(verdict)) = (reseeded.paths.get_mut(best), reseeded.verdicts.get_mut(best)) {
+        *slot = own.paths[0];
+        *verdict = own.verdicts[0];
+    }
+    reseeded.stage = Stage::Search;
+    Ok(reseeded)
+}
