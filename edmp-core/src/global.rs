@@ -19,7 +19,7 @@ use crate::error::Error;
 use crate::guidance::guide_step;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::planner::{Plan, PlanConfig, Workspace, select};
+use crate::planner::{Plan, PlanConfig, Workspace, judge, rank_in_full, select};
 use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise};
 use crate::rng::Rng;
 use crate::scene::Scene;
@@ -98,8 +98,9 @@ pub struct SearchReport {
     pub segment_checks: u32,
 }
 
-/// The global stage after a first stage whose candidates all collide (`first`); returns
-/// `first` unchanged (with the search's report) when the search finds nothing.
+/// The global stage after a first stage whose candidates all collide (`plan`, changed in
+/// place): when the search finds nothing, `plan` keeps the first stage's candidates (ranked
+/// in full) and the search's report.
 #[allow(clippy::too_many_arguments)]
 pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     scene: &Scene<N>,
@@ -111,8 +112,8 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     rng: &mut Rng,
     scratch: &mut Scratch<C>,
     work: &mut Workspace<B, CAP>,
-    first: Plan<B>,
-) -> Result<Plan<B>, Error> {
+    plan: &mut Plan<B>,
+) -> Result<(), Error> {
     global.validate()?;
     let mut calls = 0u32;
     let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| {
@@ -127,14 +128,14 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
         segment_checks: calls,
     };
     let Some(outcome) = found else {
-        return Ok(Plan {
-            search: Some(report(false, 0, global.search.max_iterations)),
-            ..first
-        });
+        rank_in_full(scene, config, plan)?;
+        plan.search = Some(report(false, 0, global.search.max_iterations));
+        return Ok(());
     };
     let searched = report(true, outcome.nodes, outcome.iterations);
-    let mut paths = [outcome.path; B];
-    for x in paths.iter_mut() {
+    // The first stage's candidates are spent: their memory holds the reseeded ones.
+    for x in plan.paths.iter_mut() {
+        *x = outcome.path;
         prior::diffuse(x, global.noise_step, rng, start, goal);
     }
     let strided = Sampler::Strided { steps: global.steps };
@@ -152,40 +153,43 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     };
     for j in 0..usize::from(global.steps) {
         let step = Step::partial(global.noise_step, global.steps, j);
-        predict_noise(&paths, &TimeEmbedding::new(step.t)?, scratch, &mut work.eps)?;
-        for (x, e) in paths.iter_mut().zip(&work.eps) {
+        predict_noise(&plan.paths, &TimeEmbedding::new(step.t)?, scratch, &mut work.eps)?;
+        for (x, e) in plan.paths.iter_mut().zip(&work.eps) {
             strided.update(step, x, e, rng, start, goal);
         }
         if step.t >= 5 {
             for _ in 0..global.per_step {
-                guide(&mut paths, &mut work.grads, step.t)?;
+                guide(&mut plan.paths, &mut work.grads, step.t)?;
             }
         }
     }
     for _ in 0..global.refine {
-        guide(&mut paths, &mut work.grads, 1)?;
+        guide(&mut plan.paths, &mut work.grads, 1)?;
     }
-    let mut reseeded = select(scene, start, goal, config, paths)?;
-    reseeded.search = Some(searched);
-    if reseeded.is_free() {
-        reseeded.stage = Stage::Reseeded;
-        return Ok(reseeded);
+    judge(scene, start, goal, config, plan)?;
+    plan.search = Some(searched);
+    if plan.is_free() {
+        plan.stage = Stage::Reseeded;
+        return Ok(());
     }
     // The last resort: the search path itself, judged like a candidate, in the chosen row.
     let own = select(scene, start, goal, config, [outcome.path])?;
     if !own.is_free() {
         // The search checked every segment with the same checker; this cannot happen, and a
         // colliding path is never passed off as a success.
-        return Ok(Plan {
-            search: Some(searched),
-            ..first
-        });
+        rank_in_full(scene, config, plan)?;
+        return Ok(());
     }
-    let best = reseeded.best;
-    if let (Some(slot), Some(verdict)) = (reseeded.paths.get_mut(best), reseeded.verdicts.get_mut(best)) {
-        *slot = own.paths[0];
-        *verdict = own.verdicts[0];
+    let best = plan.best;
+    if let (Some(slot), Some(verdict), Some(path), Some(own_verdict)) = (
+        plan.paths.get_mut(best),
+        plan.verdicts.get_mut(best),
+        own.paths.first(),
+        own.verdicts.first(),
+    ) {
+        *slot = *path;
+        *verdict = *own_verdict;
     }
-    reseeded.stage = Stage::Search;
-    Ok(reseeded)
+    plan.stage = Stage::Search;
+    Ok(())
 }

@@ -153,9 +153,24 @@ impl PlanConfig {
 }
 
 impl<const B: usize> Plan<B> {
+    /// Zero candidates, not yet judged: the memory a plan is built in.
+    pub const fn empty() -> Self {
+        Self {
+            paths: [[[0.0; JOINTS]; HORIZON]; B],
+            verdicts: [Verdict {
+                swept: 0.0,
+                free: false,
+                colliding_states: 0,
+            }; B],
+            best: 0,
+            stage: Stage::None,
+            search: None,
+        }
+    }
+
     /// Whether the chosen candidate passed the exact checker.
     pub fn is_free(&self) -> bool {
-        self.verdicts[self.best].free
+        self.verdicts.get(self.best).is_some_and(|v| v.free)
     }
 
     /// FNV-1a (64 bit) over the bits of every candidate, every verdict and the chosen index:
@@ -226,14 +241,16 @@ pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     scratch: &mut Scratch<C>,
     work: &mut Workspace<B, CAP>,
 ) -> Result<Plan<B>, Error> {
-    let mut paths = [[[0.0f32; JOINTS]; HORIZON]; B];
-    denoise(scene, start, goal, guides, config, rng, scratch, work, &mut paths)?;
-    let first = select(scene, start, goal, config, paths)?;
-    finish(scene, start, goal, guides, config, rng, scratch, work, first)
+    // One plan's memory throughout: denoised into, judged in place, reseeded in place.
+    let mut plan = Plan::empty();
+    denoise(scene, start, goal, guides, config, rng, scratch, work, &mut plan.paths)?;
+    judge(scene, start, goal, config, &mut plan)?;
+    finish(scene, start, goal, guides, config, rng, scratch, work, &mut plan)?;
+    Ok(plan)
 }
 
 /// After [`select`]: a plan with a free candidate is done; otherwise the global stage runs
-/// when `config.global` asks for it ([`crate::global::rescue`]).
+/// when `config.global` asks for it ([`crate::global::rescue`]), in place.
 #[allow(clippy::too_many_arguments)]
 pub fn finish<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     scene: &Scene<N>,
@@ -244,13 +261,11 @@ pub fn finish<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     rng: &mut Rng,
     scratch: &mut Scratch<C>,
     work: &mut Workspace<B, CAP>,
-    first: Plan<B>,
-) -> Result<Plan<B>, Error> {
+    plan: &mut Plan<B>,
+) -> Result<(), Error> {
     match &config.global {
-        Some(global) if !first.is_free() => {
-            rescue(scene, start, goal, guides, config, global, rng, scratch, work, first)
-        }
-        _ => Ok(first),
+        Some(global) if !plan.is_free() => rescue(scene, start, goal, guides, config, global, rng, scratch, work, plan),
+        _ => Ok(()),
     }
 }
 
@@ -322,29 +337,40 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
 /// and the uninflated swept volume, and picks the winner.
 ///
 /// The check of a colliding candidate stops at its first contact; only when no candidate is
-/// free are the colliding states counted in full, to rank the fallback. A free candidate is
-/// checked state by state to the end either way.
+/// free are the colliding states counted in full, to rank the fallback ([`rank_in_full`]) —
+/// unless the global stage is to run, which counts them only if it too finds nothing. A free
+/// candidate is checked state by state to the end either way.
 pub fn select<const B: usize, const N: usize>(
     scene: &Scene<N>,
     start: &Joints<f32>,
     goal: &Joints<f32>,
     config: &PlanConfig,
-    mut paths: [Path; B],
+    paths: [Path; B],
 ) -> Result<Plan<B>, Error> {
+    let mut plan = Plan { paths, ..Plan::empty() };
+    judge(scene, start, goal, config, &mut plan)?;
+    Ok(plan)
+}
+
+/// [`select`] on the candidates already in `plan.paths`, in place (no copy of the batch: what
+/// keeps the firmware's stack small).
+pub fn judge<const B: usize, const N: usize>(
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    config: &PlanConfig,
+    plan: &mut Plan<B>,
+) -> Result<(), Error> {
     if B == 0 {
         return Err(Error::BadParameter);
     }
+    let Plan { paths, verdicts, .. } = plan;
     let swept = CostConfig {
         kind: CostKind::Swept,
         inflation: Inflation::default(),
         cylinder: config.cylinder,
         frame: config.frame,
     };
-    let mut verdicts = [Verdict {
-        swept: 0.0,
-        free: false,
-        colliding_states: 0,
-    }; B];
     for (x, verdict) in paths.iter_mut().zip(verdicts.iter_mut()) {
         for q in x.iter_mut() {
             for (j, v) in q.iter_mut().enumerate() {
@@ -360,32 +386,45 @@ pub fn select<const B: usize, const N: usize>(
             colliding_states: report.colliding_states,
         };
     }
-    if !verdicts.iter().any(|v| v.free) {
-        for (x, verdict) in paths.iter().zip(verdicts.iter_mut()) {
-            verdict.colliding_states = check_trajectory(scene, x, &config.check, false)?.colliding_states;
-        }
+    plan.best = pick(&plan.verdicts);
+    plan.stage = if plan.is_free() { Stage::Diffusion } else { Stage::None };
+    plan.search = None;
+    if !plan.is_free() && config.global.is_none() {
+        rank_in_full(scene, config, plan)?;
     }
-    let best = (0..B)
-        .min_by(|&a, &b| {
-            let (va, vb) = (verdicts[a], verdicts[b]);
+    Ok(())
+}
+
+/// The free candidate with the lowest swept volume, else the fewest colliding states (then
+/// swept volume); the lowest row on ties.
+fn pick<const B: usize>(verdicts: &[Verdict; B]) -> usize {
+    verdicts
+        .iter()
+        .enumerate()
+        .min_by(|(a, va), (b, vb)| {
             va.colliding_states
                 .cmp(&vb.colliding_states)
                 .then(va.swept.total_cmp(&vb.swept))
-                .then(a.cmp(&b))
+                .then(a.cmp(b))
         })
-        .unwrap_or(0);
-    let stage = if verdicts.get(best).is_some_and(|v| v.free) {
-        Stage::Diffusion
-    } else {
-        Stage::None
-    };
-    Ok(Plan {
-        paths,
-        verdicts,
-        best,
-        stage,
-        search: None,
-    })
+        .map_or(0, |(i, _)| i)
+}
+
+/// When no candidate is free: counts every candidate's colliding states in full and picks the
+/// least colliding one (the plan a caller gets with status "collision").
+pub fn rank_in_full<const B: usize, const N: usize>(
+    scene: &Scene<N>,
+    config: &PlanConfig,
+    plan: &mut Plan<B>,
+) -> Result<(), Error> {
+    if plan.is_free() {
+        return Ok(());
+    }
+    for (x, verdict) in plan.paths.iter().zip(plan.verdicts.iter_mut()) {
+        verdict.colliding_states = check_trajectory(scene, x, &config.check, false)?.colliding_states;
+    }
+    plan.best = pick(&plan.verdicts);
+    Ok(())
 }
 
 #[cfg(test)]
@@ -522,6 +561,50 @@ mod tests {
                 .fold(0.0f32, f32::max)
         };
         assert!(first_step(&without[0]) > 5.0 * first_step(&with[0]));
+    }
+
+    #[test]
+    fn the_global_stage_rescues_a_failed_first_stage_within_its_bound_and_repeats_bit_for_bit() {
+        // Two unguided denoising steps: every candidate crosses the wall.
+        let cfg = PlanConfig {
+            sampler: Sampler::Strided { steps: 2 },
+            guidance: GuidanceSchedule::Every { per_step: 0 },
+            global: Some(GlobalConfig::DEFAULT),
+            ..config()
+        };
+        let mut scratch = Box::new(Scratch::<4>::new());
+        let mut work = Box::new(Workspace::<12>::new());
+        let mut run = |cfg: &PlanConfig| {
+            plan(
+                &wall_scene(),
+                &START,
+                &GOAL,
+                &EDMP_GUIDES,
+                cfg,
+                &mut Rng::new(1),
+                &mut scratch,
+                &mut work,
+            )
+            .unwrap()
+        };
+        let alone = run(&PlanConfig { global: None, ..cfg });
+        assert!(!alone.is_free() && alone.stage == Stage::None && alone.search.is_none());
+        let a = run(&cfg);
+        assert!(a.is_free(), "{:?}", a.verdicts);
+        assert!(matches!(a.stage, Stage::Reseeded | Stage::Search), "{:?}", a.stage);
+        let report = a.search.unwrap();
+        assert!(report.found && report.nodes >= 2);
+        let bound = GlobalConfig::DEFAULT.search.max_oracle_calls(DEFAULT_SEARCH_NODES);
+        assert!(u64::from(report.segment_checks) <= bound, "{report:?} > {bound}");
+        let best = &a.paths[a.best];
+        assert_eq!((best[0], best[HORIZON - 1]), (START, GOAL));
+        assert!(
+            check_trajectory(&wall_scene(), best, &CheckConfig::default(), true)
+                .unwrap()
+                .is_free()
+        );
+        assert_eq!(a, run(&cfg));
+        assert_eq!(a.fingerprint(), run(&cfg).fingerprint());
     }
 
     #[test]

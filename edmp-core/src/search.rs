@@ -61,9 +61,12 @@ pub struct SearchConfig {
 }
 
 impl SearchConfig {
-    /// The planner's fallback setting: the host's RRT baseline's step and shortcut count.
+    /// The planner's fallback setting: the host's RRT baseline's step and shortcut count, and
+    /// all of the space's capacity (a plan's bits depend on it: the host's CLI holds 4,096
+    /// nodes per tree, the firmware and `edmp-host embed` 512). 8,000 iterations: on the
+    /// suites, the problems the first stage leaves need up to about 5,300.
     pub const DEFAULT: Self = Self {
-        max_iterations: 2000,
+        max_iterations: 8000,
         step: 0.3,
         shortcuts: 100,
         max_nodes: u16::MAX,

@@ -7,6 +7,7 @@ use crate::Failure;
 use crate::json::{Problem, joint_goal, parse_problem};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{BoxFrame, Inflation};
+use edmp_core::global::GlobalConfig;
 use edmp_core::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
@@ -14,12 +15,17 @@ use edmp_core::planner::{
 };
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
+use edmp_core::search::SearchConfig;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
 
 /// Rows of the batch: EDMP's 12 guides, one trajectory each.
 pub(crate) const ROWS: usize = 12;
+
+/// Nodes per search tree the host's workspace holds (`--search-nodes` may ask for up to this;
+/// the core's default asks for fewer, the firmware's capacity).
+pub(crate) const HOST_SEARCH_NODES: usize = 4096;
 
 /// Arguments of `edmp-host plan`.
 #[derive(Debug, clap::Args)]
@@ -73,6 +79,12 @@ pub(crate) struct Tuning {
     /// (EDMP alone, as the paper) instead of searching and reseeding the prior.
     #[arg(long)]
     no_global: bool,
+    /// Global stage: sampling iterations of the search before it gives up.
+    #[arg(long, default_value_t = SearchConfig::DEFAULT.max_iterations)]
+    search_iterations: u32,
+    /// Global stage: nodes per search tree (the host holds at most 4096).
+    #[arg(long, default_value_t = SearchConfig::DEFAULT.max_nodes)]
+    search_nodes: u16,
 }
 
 impl Tuning {
@@ -102,7 +114,14 @@ impl Tuning {
             global: if self.no_global {
                 None
             } else {
-                PlanConfig::DEFAULT.global
+                Some(GlobalConfig {
+                    search: SearchConfig {
+                        max_iterations: self.search_iterations,
+                        max_nodes: self.search_nodes,
+                        ..SearchConfig::DEFAULT
+                    },
+                    ..GlobalConfig::DEFAULT
+                })
             },
             ..PlanConfig::DEFAULT
         };
@@ -135,8 +154,14 @@ impl Tuning {
         } else {
             "no step limit".to_owned()
         };
+        let defaults = (SearchConfig::DEFAULT.max_iterations, SearchConfig::DEFAULT.max_nodes);
         let boxes = if self.no_global {
             format!("{boxes}, no global stage")
+        } else if (self.search_iterations, self.search_nodes) != defaults {
+            format!(
+                "{boxes}, search {} iterations × {} nodes",
+                self.search_iterations, self.search_nodes
+            )
         } else {
             boxes.to_owned()
         };
@@ -183,7 +208,7 @@ pub(crate) fn plan_problem(
     let goal = joint_goal(problem).map_err(Failure::Input)?;
     let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
     let mut scratch = Box::new(Scratch::<4>::new());
-    let mut work = Box::new(Workspace::<ROWS>::new());
+    let mut work = Box::new(Workspace::<ROWS, HOST_SEARCH_NODES>::new());
     let mut paths = Box::new([[[0.0f32; 7]; HORIZON]; ROWS]);
     let mut rng = Rng::new(seed);
     let denoise_began = Instant::now();
@@ -201,11 +226,11 @@ pub(crate) fn plan_problem(
     .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let denoise_ms = denoise_began.elapsed().as_secs_f64() * 1e3;
     let select_began = Instant::now();
-    let plan = select(&problem.scene, &problem.start, &goal, config, *paths)
+    let mut plan = select(&problem.scene, &problem.start, &goal, config, *paths)
         .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
     let global_began = Instant::now();
-    let plan = finish(
+    finish(
         &problem.scene,
         &problem.start,
         &goal,
@@ -214,7 +239,7 @@ pub(crate) fn plan_problem(
         &mut rng,
         &mut scratch,
         &mut work,
-        plan,
+        &mut plan,
     )
     .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let global_ms = global_began.elapsed().as_secs_f64() * 1e3;
@@ -277,6 +302,12 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         "waypoints": best.iter().map(|q| q.to_vec()).collect::<Vec<_>>(),
         "guide": guide_of(plan.best),
         "stage": plan.stage.name(),
+        "search": plan.search.map(|s| json!({
+            "found": s.found,
+            "nodes": s.nodes,
+            "iterations": s.iterations,
+            "segment_checks": s.segment_checks,
+        })),
         "costs": {"swept_volume": plan.verdicts[plan.best].swept, "intersection_volume": intersection},
         "seed": args.seed,
         "timing_ms": {

@@ -191,8 +191,11 @@ impl Step {
     /// strided rule applies to any such step ([`Sampler::update`] with `Sampler::Strided`).
     pub fn partial(from: u16, steps: u16, j: usize) -> Self {
         let at = |j: usize| -> u16 {
-            let (from, k) = (usize::from(from), usize::from(steps.max(1)));
-            if j >= k { 0 } else { (from - j * from / k) as u16 }
+            let (from, k) = (usize::from(from), usize::from(steps));
+            match (j * from).checked_div(k) {
+                Some(back) if j < k => from.saturating_sub(back) as u16,
+                _ => 0,
+            }
         };
         Self {
             t: at(j),

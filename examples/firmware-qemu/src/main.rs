@@ -63,6 +63,8 @@ const SCENES: &[(&str, &[u8])] = &[
     ),
     ("cubby-000", include_bytes!("../scenes/cubby-000.postcard")),
     ("dresser-000", include_bytes!("../scenes/dresser-000.postcard")),
+    // An unseen kind whose first stage collides: the global stage (search, reseeding) runs.
+    ("window_box-003", include_bytes!("../scenes/window_box-003.postcard")),
 ];
 
 /// The network's working memory for one trajectory at a time (`.bss`, not the stack).
