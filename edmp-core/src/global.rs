@@ -16,10 +16,9 @@
 
 use crate::checker::check_segment;
 use crate::error::Error;
-use crate::guidance::guide_step;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::planner::{Plan, PlanConfig, Workspace, judge, rank_in_full, select};
+use crate::planner::{Plan, PlanConfig, Workspace, guide_batch, judge, rank_in_full, select};
 use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise};
 use crate::rng::Rng;
 use crate::scene::Scene;
@@ -69,7 +68,7 @@ pub enum Stage {
     Reseeded,
     /// The search's own path (shortcut and resampled): no reseeded candidate was free.
     Search,
-    /// Nothing was free; the least colliding first-stage candidate is returned.
+    /// Nothing was free; the least colliding candidate is returned.
     None,
 }
 
@@ -90,9 +89,11 @@ impl Stage {
 pub struct SearchReport {
     /// Whether it found a path.
     pub found: bool,
-    /// Tree nodes grown (both trees).
+    /// Tree nodes grown (both trees; 0 when nothing was found, since a failed search reports
+    /// no trees).
     pub nodes: u32,
-    /// Sampling iterations.
+    /// Sampling iterations (when nothing was found: the budget, which the trees' capacity may
+    /// have cut short).
     pub iterations: u32,
     /// Segment checks asked of the exact checker.
     pub segment_checks: u32,
@@ -139,18 +140,8 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
         prior::diffuse(x, global.noise_step, rng, start, goal);
     }
     let strided = Sampler::Strided { steps: global.steps };
-    let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16| {
-        guide_step(
-            scene,
-            paths,
-            grads,
-            guides,
-            t,
-            config.step_limit,
-            config.cylinder,
-            config.frame,
-        )
-    };
+    let guide =
+        |paths: &mut [Path; B], grads: &mut [Path; B], t: u16| guide_batch(scene, paths, grads, guides, t, config);
     for j in 0..usize::from(global.steps) {
         let step = Step::partial(global.noise_step, global.steps, j);
         predict_noise(&plan.paths, &TimeEmbedding::new(step.t)?, scratch, &mut work.eps)?;
@@ -175,8 +166,9 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     // The last resort: the search path itself, judged like a candidate, in the chosen row.
     let own = select(scene, start, goal, config, [outcome.path])?;
     if !own.is_free() {
-        // The search checked every segment with the same checker; this cannot happen, and a
-        // colliding path is never passed off as a success.
+        // The search checked every segment with the same checker, so only the checker's
+        // carried-direction wrinkle near the margin could get here; a colliding path is never
+        // passed off as a success.
         rank_in_full(scene, config, plan)?;
         return Ok(());
     }

@@ -269,6 +269,28 @@ pub fn finish<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     }
 }
 
+/// One gradient step of every row's guide at diffusion step `t`, with the plan's step limit and
+/// boxes (the first stage's and the global stage's guidance alike).
+pub(crate) fn guide_batch<const B: usize, const N: usize>(
+    scene: &Scene<N>,
+    paths: &mut [Path; B],
+    grads: &mut [Path; B],
+    guides: &[Guide],
+    t: u16,
+    config: &PlanConfig,
+) -> Result<(), Error> {
+    guide_step(
+        scene,
+        paths,
+        grads,
+        guides,
+        t,
+        config.step_limit,
+        config.cylinder,
+        config.frame,
+    )
+}
+
 /// The guided reverse diffusion: `paths` end as the `B` candidates (not yet clamped or judged).
 #[allow(clippy::too_many_arguments)]
 pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>(
@@ -295,18 +317,8 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
         }
     }
     // One gradient step of every row's guide at diffusion step `t`.
-    let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16| {
-        guide_step(
-            scene,
-            paths,
-            grads,
-            guides,
-            t,
-            config.step_limit,
-            config.cylinder,
-            config.frame,
-        )
-    };
+    let guide =
+        |paths: &mut [Path; B], grads: &mut [Path; B], t: u16| guide_batch(scene, paths, grads, guides, t, config);
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
