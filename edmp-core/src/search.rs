@@ -824,7 +824,7 @@ mod tests {
         assert_eq!(SearchConfig::DEFAULT.tree_capacity(512), 512);
         assert_eq!(
             SearchConfig::DEFAULT.max_oracle_calls(512),
-            1 + 2000 + 2 * 511 + 100 + 98
+            1 + 8000 + 2 * 511 + 100 + 98
         );
     }
 
