@@ -109,8 +109,8 @@ pub(crate) struct Record {
     /// `none`).
     #[serde(default)]
     pub(crate) stage: Option<String>,
-    /// Milliseconds in the global stage (EDMP; 0 when every first-stage candidate collided
-    /// and no global stage was asked for, or when one was free).
+    /// Milliseconds in the global stage (EDMP; next to nothing when a first-stage candidate
+    /// was free or no global stage was asked for).
     #[serde(default)]
     pub(crate) global_ms: Option<f64>,
     /// Every candidate's verdict (EDMP).

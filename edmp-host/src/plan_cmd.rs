@@ -23,8 +23,8 @@ use std::time::Instant;
 /// Rows of the batch: EDMP's 12 guides, one trajectory each.
 pub(crate) const ROWS: usize = 12;
 
-/// Nodes per search tree the host's workspace holds (`--search-nodes` may ask for up to this;
-/// the core's default asks for fewer, the firmware's capacity).
+/// Nodes per search tree the host's workspace holds (the core's default search takes all of
+/// them, `--search-nodes` fewer; the firmware and `edmp-host embed` hold 512).
 pub(crate) const HOST_SEARCH_NODES: usize = 4096;
 
 /// Arguments of `edmp-host plan`.
