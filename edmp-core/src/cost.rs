@@ -506,6 +506,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "costs and gradient of a whole trajectory: too slow")]
     fn a_box_around_the_hand_costs_and_pulls() {
         let k = forward(&READY).unwrap();
         let hand = k.frames[HAND_FRAME].translation;

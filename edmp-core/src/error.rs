@@ -21,6 +21,12 @@ pub enum Error {
     /// Two consecutive waypoints are so far apart that interpolating them at the checker's
     /// step would exceed its fixed budget of states per segment.
     SegmentTooLong,
+    /// A joint of a start or goal lies outside the soft limits where the computation needs it
+    /// inside (the global stage's search: its trees live within the limits).
+    OutsideLimits {
+        /// Index of the offending joint.
+        joint: u8,
+    },
 }
 
 impl fmt::Display for Error {
@@ -31,6 +37,7 @@ impl fmt::Display for Error {
             Self::Overflow => f.write_str("result overflowed to a non-finite value"),
             Self::BadParameter => f.write_str("a parameter is negative or not finite"),
             Self::SegmentTooLong => f.write_str("consecutive waypoints are too far apart to interpolate"),
+            Self::OutsideLimits { joint } => write!(f, "joint {joint} is outside the soft limits"),
         }
     }
 }

@@ -263,6 +263,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "IK: up to 6,400 iterations and the checker: too slow")]
     fn finds_the_ready_pose_again() {
         let ready = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
         let target = *forward(&ready).unwrap().tcp();
@@ -275,6 +276,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "IK: up to 6,400 iterations and the checker: too slow")]
     fn unreachable_and_bad_targets_are_errors() {
         let far = Pose {
             rotation: Matrix3::identity(),

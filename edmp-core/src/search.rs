@@ -183,8 +183,9 @@ pub struct SearchOutcome {
 ///
 /// `Ok(None)` when the budget (iterations or tree capacity) runs out, or when neither
 /// resampling of the found polyline passes the oracle: "no path", never an unchecked one.
-/// Errors: a non-finite end ([`Error::NonFiniteJoint`]), a bad config
-/// ([`Error::BadParameter`]), or whatever `edge_free` returns, passed on at once.
+/// Errors: a non-finite end ([`Error::NonFiniteJoint`]), an end outside the soft limits
+/// ([`Error::OutsideLimits`]), a bad config ([`Error::BadParameter`]), or whatever `edge_free`
+/// returns, passed on at once.
 ///
 /// Work: at most [`SearchConfig::max_oracle_calls`]`(CAP)` oracle calls; the rng advances by
 /// `JOINTS` numbers per iteration and two per shortcut attempt.
@@ -198,6 +199,8 @@ pub fn search<const CAP: usize>(
 ) -> Result<Option<SearchOutcome>, Error> {
     check_finite(start)?;
     check_finite(goal)?;
+    check_within_limits(start)?;
+    check_within_limits(goal)?;
     config.validate()?;
     let capacity = config.tree_capacity(CAP);
     if capacity == 0 {
@@ -614,6 +617,25 @@ fn check_finite(q: &Joints<f32>) -> Result<(), Error> {
     }
 }
 
+/// Ends inside the soft limits (the spec's 1e-5 rad tolerance): the trees grow within them, and
+/// an end far outside would make path lengths overflow (a fuzz finding:
+/// `fuzz/artifacts-kept/search/nan-path-huge-start`).
+fn check_within_limits(q: &Joints<f32>) -> Result<(), Error> {
+    let outside = q
+        .iter()
+        .zip(PANDA.soft_lower.iter().zip(PANDA.soft_upper.iter()))
+        .position(|(v, (lo, hi))| !(*v >= lo - LIMIT_TOLERANCE && *v <= hi + LIMIT_TOLERANCE));
+    match outside {
+        Some(joint) => Err(Error::OutsideLimits {
+            joint: u8::try_from(joint).unwrap_or(u8::MAX),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// How far outside the soft limits an end may lie (`spec/formats.md`).
+const LIMIT_TOLERANCE: f32 = 1e-5;
+
 /// Uniform in `0..n` for a `usize` bound (`n` fits `u32` here: paths hold < 2^17 points).
 fn below(rng: &mut Rng, n: usize) -> usize {
     rng.below(u32::try_from(n).unwrap_or(u32::MAX)) as usize
@@ -750,6 +772,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn finds_the_gap_in_a_wall() {
         for seed in 0..20 {
             let (out, calls) = run::<2048>(Some(GAPPED), &SearchConfig::DEFAULT, seed);
@@ -767,6 +790,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn a_closed_wall_is_no_path_within_the_budget() {
         let config = SearchConfig {
             max_iterations: 300,
@@ -779,6 +803,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn deterministic_for_a_seed() {
         let (a, ca) = run::<1024>(Some(GAPPED), &SearchConfig::DEFAULT, 11);
         let (b, cb) = run::<1024>(Some(GAPPED), &SearchConfig::DEFAULT, 11);
@@ -800,6 +825,36 @@ mod tests {
     }
 
     #[test]
+    fn ends_outside_the_limits_are_typed_errors_not_nan_paths() {
+        // The fuzz finding `fuzz/artifacts-kept/search/nan-path-huge-start`: a start far outside
+        // the limits once gave waypoints of NaN (the path length overflowed f32).
+        let start = [-2.088_445_4e38, -2.588, 1.695, 1.783, -2.121, 1.09e-19, 5.4e-39];
+        let goal = [0.0, 3.168, 2.9e-39, 1.824, 3.295, -3.297, 0.039];
+        let mut space = std::boxed::Box::new(SearchSpace::<8>::new());
+        let mut free = |_: &Joints<f32>, _: &Joints<f32>| Ok(true);
+        let out = search(
+            &start,
+            &goal,
+            &SearchConfig::DEFAULT,
+            &mut space,
+            &mut Rng::new(1),
+            &mut free,
+        );
+        assert_eq!(out.err(), Some(Error::OutsideLimits { joint: 0 }));
+        let inside = [0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0];
+        let out = search(
+            &inside,
+            &goal,
+            &SearchConfig::DEFAULT,
+            &mut space,
+            &mut Rng::new(1),
+            &mut free,
+        );
+        assert_eq!(out.err(), Some(Error::OutsideLimits { joint: 1 }));
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn work_stays_within_the_documented_bound() {
         // Tight budgets of every kind, against the closed wall (the worst case: no early exit).
         for (iterations, shortcuts, nodes) in [(0, 0, 2), (1, 5, 2), (50, 10, 8), (400, 100, 64), (2000, 0, 300)] {
@@ -829,6 +884,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn capacity_exhaustion_is_no_path() {
         // Eight nodes per tree cannot reach through the gap; neither can 8 of a larger space.
         let (out, calls) = run::<8>(Some(GAPPED), &SearchConfig::DEFAULT, 5);
@@ -887,6 +943,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn a_space_can_be_a_static_and_is_reusable() {
         static EMPTY: SearchSpace<4> = SearchSpace::new();
         assert_eq!(EMPTY.len, [0, 0]);
@@ -925,6 +982,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn shortcuts_only_remove_waypoints_the_oracle_frees() {
         let mut path = [mark(0.0), mark(1.0), mark(2.0), mark(3.0), mark(4.0)];
         // Only 0 → 4 is free besides neighbours: every join must be (0, 4) or none.
@@ -940,6 +998,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn a_cut_corner_falls_back_to_the_vertices() {
         // An oracle that frees a short segment (< 0.2 rad) only on an edge it freed before:
         // growth and shortcuts work as against the gapped wall, but every even-resampling

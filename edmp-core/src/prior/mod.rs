@@ -348,6 +348,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "the UNet or its 1 MB of weights: too slow under Miri")]
     fn embedded_weights_match_their_checksum() {
         assert!(weights_intact());
         assert_eq!(weight_blob().len(), WEIGHT_BYTES);
@@ -362,6 +363,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "the UNet or its 1 MB of weights: too slow under Miri")]
     fn noise_prediction_refuses_nan_and_does_not_depend_on_the_batch() {
         let time = TimeEmbedding::new(100).unwrap();
         let mut rng = Rng::new(3);
@@ -389,6 +391,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "the UNet or its 1 MB of weights: too slow under Miri")]
     fn samples_keep_start_and_goal_and_stay_finite() {
         let (start, goal) = (
             [0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
