@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 /// Which planner runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum Planner {
+pub enum Planner {
     /// EDMP (the core planner; `--guides` and the tuning flags select the variant).
     Edmp,
     /// The RRT-Connect baseline with shortcutting and smoothing.
@@ -31,7 +31,7 @@ pub(crate) enum Planner {
 
 /// Arguments of `edmp-host bench`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// Folder with one sub-folder of `edmp-scene/1` files per family.
     #[arg(long, default_value = "benchmarks/problems")]
     problems: PathBuf,
@@ -65,64 +65,65 @@ pub(crate) struct Args {
 
 /// One candidate of the ensemble.
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub(crate) struct Candidate {
+pub struct Candidate {
     /// The guide it followed (the original's number).
-    pub(crate) guide: u8,
+    pub guide: u8,
     /// Passed the project's exact checker.
-    pub(crate) free: bool,
+    pub free: bool,
     /// Swept volume against the uninflated obstacles.
-    pub(crate) swept: f32,
+    pub swept: f32,
 }
 
 /// One problem's result: a line of `results.jsonl`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub(crate) struct Record {
+pub struct Record {
     /// Problem path relative to the problem folder, e.g. `cubby/003.json`.
-    pub(crate) problem: String,
+    pub problem: String,
     /// Scene family (the sub-folder).
-    pub(crate) family: String,
+    pub family: String,
     /// The run's label.
-    pub(crate) planner: String,
+    pub planner: String,
     /// Guides of the EDMP run (empty for RRT-Connect).
-    pub(crate) guides: Vec<u8>,
+    pub guides: Vec<u8>,
     /// The EDMP settings besides the guides (sampler, steps, limits, boxes; empty for
     /// RRT-Connect): runs compare in ablations only when these agree.
     #[serde(default)]
-    pub(crate) config: String,
+    pub config: String,
     /// Random seed.
-    pub(crate) seed: u64,
+    pub seed: u64,
     /// Planned one problem at a time (`--serial`): only then do times compare across runs.
     #[serde(default)]
-    pub(crate) serial: bool,
+    pub serial: bool,
     /// `success` (passed the project's checker), `collision` (EDMP's least colliding
     /// candidate) or `failure` (RRT-Connect found nothing within its budget).
-    pub(crate) status: String,
+    pub status: String,
     /// Planning time, milliseconds (IK + denoising + selection, or the whole RRT search).
-    pub(crate) time_ms: f64,
+    pub time_ms: f64,
     /// Joint-space length of the returned path (radians; absent without a path).
-    pub(crate) path_length: Option<f64>,
+    pub path_length: Option<f64>,
     /// Roughness of the returned path.
     pub(crate) roughness: Option<Roughness>,
     /// The guide whose candidate was returned (EDMP).
-    pub(crate) guide: Option<u8>,
+    pub guide: Option<u8>,
     /// The stage that produced the returned path (EDMP: `diffusion`, `reseeded`, `search` or
     /// `none`).
     #[serde(default)]
-    pub(crate) stage: Option<String>,
+    pub stage: Option<String>,
     /// Milliseconds in the global stage (EDMP; next to nothing when a first-stage candidate
     /// was free or no global stage was asked for).
     #[serde(default)]
-    pub(crate) global_ms: Option<f64>,
+    pub global_ms: Option<f64>,
     /// Every candidate's verdict (EDMP).
-    pub(crate) candidates: Vec<Candidate>,
+    pub candidates: Vec<Candidate>,
     /// Mean pairwise cosine similarity of the ensemble's candidates (EDMP; lower: more diverse).
-    pub(crate) acsm: Option<f64>,
+    pub acsm: Option<f64>,
     /// The returned path (50 × 7; empty without a path).
-    pub(crate) waypoints: Vec<Joints<f32>>,
+    pub waypoints: Vec<Joints<f32>>,
 }
 
 impl Record {
-    pub(crate) fn solved(&self) -> bool {
+    /// Whether the planner called the problem solved.
+    pub fn solved(&self) -> bool {
         self.status == "success"
     }
 }
@@ -239,7 +240,7 @@ fn run_rrt(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
 
 /// One row of a per-family table: solved, times, path length and roughness of solved plans,
 /// mean ACSM.
-pub(crate) fn table_row(name: &str, records: &[&Record]) -> String {
+pub fn table_row(name: &str, records: &[&Record]) -> String {
     let n = records.len();
     let solved: Vec<&&Record> = records.iter().filter(|r| r.solved()).collect();
     let mut times: Vec<f64> = records.iter().map(|r| r.time_ms).collect();
@@ -273,10 +274,10 @@ pub(crate) fn table_row(name: &str, records: &[&Record]) -> String {
 }
 
 /// The header matching [`table_row`].
-pub(crate) const TABLE_HEADER: &str = "| | solved | median ms | p95 ms | path length (rad) | AR | MRESG | RF2W | RL2W | ACSM |\n|---|---|---|---|---|---|---|---|---|---|";
+pub const TABLE_HEADER: &str = "| | solved | median ms | p95 ms | path length (rad) | AR | MRESG | RF2W | RL2W | ACSM |\n|---|---|---|---|---|---|---|---|---|---|";
 
 /// The families of a record set, in order of first appearance.
-pub(crate) fn families(records: &[Record]) -> Vec<String> {
+pub fn families(records: &[Record]) -> Vec<String> {
     let mut out: Vec<String> = Vec::new();
     for r in records {
         if !out.contains(&r.family) {
@@ -287,7 +288,7 @@ pub(crate) fn families(records: &[Record]) -> Vec<String> {
 }
 
 /// Runs the benchmark and writes its files.
-pub(crate) fn run(args: &Args) -> Result<(), Failure> {
+pub fn run(args: &Args) -> Result<(), Failure> {
     let input = Failure::Input;
     let guides: Vec<u8> = match args.planner {
         Planner::Edmp => chosen_guides(&args.guides)?.iter().map(|g| g.id).collect(),
@@ -408,7 +409,7 @@ fn write_outputs(dir: &Path, label: &str, records: &[Record]) -> Result<(), Stri
 }
 
 /// The empirical distribution of one family's planning times, as (ms, %) steps.
-pub(crate) fn cdf(records: &[Record], family: &str) -> Vec<(f64, f64)> {
+pub fn cdf(records: &[Record], family: &str) -> Vec<(f64, f64)> {
     let mut t: Vec<f64> = records
         .iter()
         .filter(|r| family.is_empty() || r.family == family)
@@ -425,7 +426,7 @@ pub(crate) fn cdf(records: &[Record], family: &str) -> Vec<(f64, f64)> {
 }
 
 /// Reads a run's `results.jsonl`.
-pub(crate) fn read_results(dir: &Path) -> Result<Vec<Record>, String> {
+pub fn read_results(dir: &Path) -> Result<Vec<Record>, String> {
     let path = dir.join("results.jsonl");
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     text.lines()

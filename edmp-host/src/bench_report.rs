@@ -17,7 +17,7 @@ use std::path::PathBuf;
 
 /// Arguments of `edmp-host bench-report`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// Output folders of `edmp-host bench` runs.
     #[arg(required = true)]
     runs: Vec<PathBuf>,
@@ -61,7 +61,7 @@ impl Run {
 }
 
 /// Writes the report and charts.
-pub(crate) fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<(), String> {
     let runs: Vec<Run> = args
         .runs
         .iter()

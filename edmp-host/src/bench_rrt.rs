@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 /// Arguments of `edmp-host bench-rrt`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// Folder with one sub-folder of `edmp-scene/1` files per family.
     #[arg(long, default_value = "benchmarks/problems")]
     problems: PathBuf,
@@ -57,7 +57,7 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 }
 
 /// Runs the benchmark and prints the table.
-pub(crate) fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<(), String> {
     let families = crate::suite::read_folder(&args.problems, usize::MAX)?;
     let budget = Duration::from_millis(args.budget_ms);
     println!(

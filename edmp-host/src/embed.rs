@@ -19,11 +19,11 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 /// Rows of the firmware's batch: one per EDMP guide.
-pub(crate) const ROWS: usize = 12;
+pub const ROWS: usize = 12;
 
 /// Arguments of `edmp-host embed`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// Scene files (`edmp-scene/1` JSON).
     #[arg(required = true)]
     scenes: Vec<PathBuf>,
@@ -89,7 +89,7 @@ fn primitive(v: &Value, path: &str) -> Result<Primitive, String> {
 }
 
 /// The wire problem of a scene file: validated by `parse_problem`, goal resolved to joints.
-pub(crate) fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, String> {
+pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, String> {
     let parsed = parse_problem(text).map_err(|e| e.to_string())?;
     let goal = joint_goal(&parsed)?;
     let root: Value = serde_json::from_str(text).map_err(|e| e.to_string())?;
@@ -118,7 +118,7 @@ pub(crate) fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLE
 }
 
 /// The firmware's plan, on the host: same configuration, guides, rows and seed.
-pub(crate) fn plan_like_firmware(problem: &Problem<MAX_OBSTACLES>) -> Result<Plan<ROWS>, String> {
+pub fn plan_like_firmware(problem: &Problem<MAX_OBSTACLES>) -> Result<Plan<ROWS>, String> {
     let scene: Scene<MAX_OBSTACLES> = problem.to_scene().map_err(|e| e.to_string())?;
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<ROWS>::new());
@@ -137,7 +137,7 @@ pub(crate) fn plan_like_firmware(problem: &Problem<MAX_OBSTACLES>) -> Result<Pla
 }
 
 /// Writes the bytes and the expected results.
-pub(crate) fn run(args: &Args) -> Result<(), Failure> {
+pub fn run(args: &Args) -> Result<(), Failure> {
     let input = |e: String| Failure::Input(e);
     std::fs::create_dir_all(&args.out).map_err(|e| input(format!("{}: {e}", args.out.display())))?;
     let mut expected = String::new();

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 /// Arguments of `edmp-host fk`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// The 7 joint angles in radians, joint 1 first.
     #[arg(num_args = JOINTS, value_name = "JOINT", allow_negative_numbers = true, required = true)]
     joints: Vec<f64>,
@@ -55,7 +55,7 @@ impl From<&Pose<f32>> for PoseOut {
 }
 
 /// Checks the joints (finite, f32-representable) and prints the kinematics.
-pub(crate) fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<(), String> {
     let mut q = [0.0f32; JOINTS];
     for (i, (&value, slot)) in args.joints.iter().zip(q.iter_mut()).enumerate() {
         if !value.is_finite() || value.abs() > f64::from(f32::MAX) {

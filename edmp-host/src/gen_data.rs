@@ -24,7 +24,7 @@ use std::time::Instant;
 
 /// Arguments of `edmp-host gen-data`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// How many trajectories to write.
     #[arg(long)]
     problems: usize,
@@ -100,7 +100,7 @@ fn harvest(seed: u64) -> Harvest {
 }
 
 /// Writes `data` as a C-order float32 `.npy` array of shape `(n, HORIZON, 7)`.
-pub(crate) fn write_npy(path: &Path, data: &[[Joints<f32>; HORIZON]]) -> std::io::Result<()> {
+pub fn write_npy(path: &Path, data: &[[Joints<f32>; HORIZON]]) -> std::io::Result<()> {
     let dict = format!(
         "{{'descr': '<f4', 'fortran_order': False, 'shape': ({}, {HORIZON}, 7), }}",
         data.len()
@@ -119,7 +119,7 @@ pub(crate) fn write_npy(path: &Path, data: &[[Joints<f32>; HORIZON]]) -> std::io
 }
 
 /// Generates and writes the trajectories, with a progress bar and a summary.
-pub(crate) fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<(), String> {
     let began = Instant::now();
     let bar = ProgressBar::new(args.problems as u64);
     bar.set_style(

@@ -11,7 +11,7 @@ use std::fmt;
 
 /// A field of the input that is wrong, and why.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub(crate) struct InputError {
+pub struct InputError {
     path: String,
     message: String,
 }
@@ -37,18 +37,26 @@ impl fmt::Display for InputError {
 
 /// The goal of a problem.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Goal {
+pub enum Goal {
     /// A joint configuration.
     Joints(Joints<f32>),
     /// A TCP pose: position and quaternion `[w, x, y, z]`.
-    Pose { position: [f32; 3], quaternion: [f32; 4] },
+    Pose {
+        /// TCP position in the world, metres.
+        position: [f32; 3],
+        /// TCP orientation, `[w, x, y, z]`.
+        quaternion: [f32; 4],
+    },
 }
 
 /// A parsed, validated problem.
 #[derive(Clone, Debug)]
-pub(crate) struct Problem {
+pub struct Problem {
+    /// The obstacles (and the held object).
     pub scene: Scene<MAX_OBSTACLES>,
+    /// The start configuration.
     pub start: Joints<f32>,
+    /// The goal: joints or a TCP pose.
     pub goal: Goal,
 }
 
@@ -193,7 +201,7 @@ fn describe(contact: Contact) -> String {
 
 /// The problem's goal as joints: itself for a joint goal, the core IK's collision-free solution
 /// nearest the start for a pose goal. The error names the field.
-pub(crate) fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
+pub fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
     match problem.goal {
         Goal::Joints(q) => Ok(q),
         Goal::Pose { position, quaternion } => {
@@ -210,7 +218,7 @@ pub(crate) fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
 }
 
 /// Parses and validates an `edmp-scene/1` document.
-pub(crate) fn parse_problem(text: &str) -> Result<Problem, InputError> {
+pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
     let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
     // `meta` (optional, free-form provenance such as the family, seed and the TCP pose of a
     // joint goal) is an extension of the format; the planner ignores it.

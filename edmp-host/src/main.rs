@@ -1,25 +1,11 @@
-//! `edmp-host`: the command line of edmp-rs. Planning math lives in `edmp-core`; this crate
-//! reads and writes files, checks input and names the bad field, and prints results.
+//! `edmp-host`: the command line of edmp-rs. The commands live in the `edmp_host` library;
+//! this binary parses the arguments, runs one and maps its outcome to the exit status.
 
 use clap::{Parser, Subcommand};
+use edmp_host::{
+    Failure, bench, bench_report, bench_rrt, embed, fk, gen_data, plan_cmd, render, rrt_cmd, sample, suite,
+};
 use std::process::ExitCode;
-
-mod bench;
-mod bench_report;
-mod bench_rrt;
-mod embed;
-mod fk;
-mod gen_data;
-mod json;
-mod metrics;
-mod plan_cmd;
-mod plots;
-mod render;
-mod rrt;
-mod rrt_cmd;
-mod sample;
-mod scenes;
-mod suite;
 
 /// EDMP motion planning for the Franka Panda.
 #[derive(Debug, Parser)]
@@ -53,14 +39,6 @@ enum Command {
     Sample(sample::Args),
     /// Scenes as postcard bytes for the QEMU firmware, with the host's plan of each.
     Embed(embed::Args),
-}
-
-/// What went wrong, and the exit status it maps to (`spec/formats.md`).
-pub(crate) enum Failure {
-    /// Bad input or I/O: exit 2, nothing written.
-    Input(String),
-    /// Ran, but found no path: exit 1.
-    NoPath(String),
 }
 
 fn main() -> ExitCode {

@@ -21,15 +21,15 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// Rows of the batch: EDMP's 12 guides, one trajectory each.
-pub(crate) const ROWS: usize = 12;
+pub const ROWS: usize = 12;
 
 /// Nodes per search tree the host's workspace holds (the core's default search takes all of
 /// them, `--search-nodes` fewer; the firmware and `edmp-host embed` hold 512).
-pub(crate) const HOST_SEARCH_NODES: usize = 4096;
+pub const HOST_SEARCH_NODES: usize = 4096;
 
 /// Arguments of `edmp-host plan`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// The scene and problem (`edmp-scene/1` JSON).
     scene: PathBuf,
     /// Write the plan here instead of standard output.
@@ -50,7 +50,7 @@ pub(crate) struct Args {
 
 /// The planner's knobs, shared by `plan` and `bench`.
 #[derive(Debug, Clone, clap::Args)]
-pub(crate) struct Tuning {
+pub struct Tuning {
     /// Denoising steps K of the strided sampler.
     #[arg(long, default_value_t = DEFAULT_STEPS)]
     steps: u16,
@@ -89,7 +89,7 @@ pub(crate) struct Tuning {
 
 impl Tuning {
     /// The core's configuration, or the bad flag.
-    pub(crate) fn config(&self) -> Result<PlanConfig, Failure> {
+    pub fn config(&self) -> Result<PlanConfig, Failure> {
         let config = PlanConfig {
             sampler: if self.ancestral {
                 Sampler::Ancestral
@@ -142,7 +142,7 @@ impl Tuning {
     }
 
     /// A short label for tables.
-    pub(crate) fn label(&self) -> String {
+    pub fn label(&self) -> String {
         let boxes = match (self.world_boxes, self.no_conditioning) {
             (false, false) => "",
             (true, false) => ", world AABBs",
@@ -180,30 +180,29 @@ impl Tuning {
 }
 
 /// A planned problem and where the time went.
-pub(crate) struct Planned {
+#[derive(Debug)]
+pub struct Planned {
     /// Candidates, verdicts, the winner.
-    pub(crate) plan: Plan<ROWS>,
-    /// Milliseconds in IK, in the guided denoising, in the selection, in the global stage.
-    pub(crate) ik_ms: f64,
-    pub(crate) denoise_ms: f64,
-    pub(crate) select_ms: f64,
-    pub(crate) global_ms: f64,
+    pub plan: Plan<ROWS>,
+    /// Milliseconds in IK.
+    pub ik_ms: f64,
+    /// Milliseconds in the guided denoising.
+    pub denoise_ms: f64,
+    /// Milliseconds in the selection.
+    pub select_ms: f64,
+    /// Milliseconds in the global stage.
+    pub global_ms: f64,
 }
 
 impl Planned {
     /// Planning time in all, milliseconds.
-    pub(crate) fn total_ms(&self) -> f64 {
+    pub fn total_ms(&self) -> f64 {
         self.ik_ms + self.denoise_ms + self.select_ms + self.global_ms
     }
 }
 
 /// Plans a parsed problem: IK for a pose goal, then the core planner with `ROWS` rows.
-pub(crate) fn plan_problem(
-    problem: &Problem,
-    guides: &[Guide],
-    config: &PlanConfig,
-    seed: u64,
-) -> Result<Planned, Failure> {
+pub fn plan_problem(problem: &Problem, guides: &[Guide], config: &PlanConfig, seed: u64) -> Result<Planned, Failure> {
     let ik_began = Instant::now();
     let goal = joint_goal(problem).map_err(Failure::Input)?;
     let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
@@ -253,7 +252,7 @@ pub(crate) fn plan_problem(
 }
 
 /// The guides named on the command line (all of EDMP's when none).
-pub(crate) fn chosen_guides(ids: &[u8]) -> Result<Vec<Guide>, Failure> {
+pub fn chosen_guides(ids: &[u8]) -> Result<Vec<Guide>, Failure> {
     if ids.is_empty() {
         return Ok(EDMP_GUIDES.to_vec());
     }
@@ -274,16 +273,17 @@ pub(crate) fn chosen_guides(ids: &[u8]) -> Result<Vec<Guide>, Failure> {
     Ok(out)
 }
 
-/// Plans and writes the plan.
-pub(crate) fn run(args: &Args) -> Result<(), Failure> {
-    let began = Instant::now();
-    let text =
-        std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
-    let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
-    let guides = chosen_guides(&args.guides)?;
-    let config = args.tuning.config()?;
-
-    let planned = plan_problem(&problem, &guides, &config, args.seed)?;
+/// The `edmp-plan/1` document of a planned problem (`spec/formats.md`): the one writer of the
+/// format, which the CLI and the Python package share. `total_ms` is the caller's wall time.
+pub fn plan_document(
+    problem: &Problem,
+    planned: &Planned,
+    guides: &[Guide],
+    config: &PlanConfig,
+    seed: u64,
+    candidates: bool,
+    total_ms: f64,
+) -> Result<serde_json::Value, Failure> {
     let plan = &planned.plan;
     let best = &plan.paths[plan.best];
     let iv = CostConfig {
@@ -309,16 +309,16 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
             "segment_checks": s.segment_checks,
         })),
         "costs": {"swept_volume": plan.verdicts[plan.best].swept, "intersection_volume": intersection},
-        "seed": args.seed,
+        "seed": seed,
         "timing_ms": {
-            "total": began.elapsed().as_secs_f64() * 1e3,
+            "total": total_ms,
             "ik": planned.ik_ms,
             "denoise": planned.denoise_ms,
             "select": planned.select_ms,
             "global": planned.global_ms,
         },
     });
-    if args.candidates {
+    if candidates {
         out["candidates"] = plan
             .paths
             .iter()
@@ -334,6 +334,30 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
             })
             .collect();
     }
+    Ok(out)
+}
+
+/// Plans and writes the plan.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let began = Instant::now();
+    let text =
+        std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let guides = chosen_guides(&args.guides)?;
+    let config = args.tuning.config()?;
+
+    let planned = plan_problem(&problem, &guides, &config, args.seed)?;
+    let total_ms = began.elapsed().as_secs_f64() * 1e3;
+    let out = plan_document(
+        &problem,
+        &planned,
+        &guides,
+        &config,
+        args.seed,
+        args.candidates,
+        total_ms,
+    )?;
+    let plan = &planned.plan;
     let text = serde_json::to_string_pretty(&out).map_err(|e| Failure::Input(e.to_string()))? + "\n";
     match &args.output {
         Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?,

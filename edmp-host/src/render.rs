@@ -16,7 +16,7 @@ use std::path::PathBuf;
 
 /// Arguments of `edmp-host render`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// The scene (`edmp-scene/1`).
     scene: PathBuf,
     /// A plan (`edmp-plan/1`) to draw on it.
@@ -57,14 +57,16 @@ const CANDIDATE_COLOURS: [[f32; 3]; 6] = [
 ];
 
 /// An RGB raster with alpha-blended convex fills (no anti-aliasing).
-pub(crate) struct Canvas {
+#[derive(Debug)]
+pub struct Canvas {
     width: usize,
     height: usize,
     pixels: Vec<[f32; 3]>,
 }
 
 impl Canvas {
-    pub(crate) fn new(width: usize, height: usize) -> Self {
+    /// A white canvas of `width` × `height` pixels.
+    pub fn new(width: usize, height: usize) -> Self {
         Self {
             width,
             height,
@@ -73,7 +75,7 @@ impl Canvas {
     }
 
     /// Fills a convex polygon (pixel coordinates) blending `color` with opacity `alpha`.
-    pub(crate) fn fill(&mut self, poly: &[[f32; 2]], color: [f32; 3], alpha: f32) {
+    pub fn fill(&mut self, poly: &[[f32; 2]], color: [f32; 3], alpha: f32) {
         if poly.len() < 3 {
             return;
         }
@@ -117,7 +119,7 @@ impl Canvas {
     }
 
     /// A straight segment `width` pixels wide.
-    pub(crate) fn line(&mut self, a: [f32; 2], b: [f32; 2], width: f32, color: [f32; 3], alpha: f32) {
+    pub fn line(&mut self, a: [f32; 2], b: [f32; 2], width: f32, color: [f32; 3], alpha: f32) {
         let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
         let len = (dx * dx + dy * dy).sqrt().max(1e-6);
         let (nx, ny) = (-dy / len * width * 0.5, dx / len * width * 0.5);
@@ -130,7 +132,8 @@ impl Canvas {
         self.fill(&quad, color, alpha);
     }
 
-    pub(crate) fn png(&self, path: &std::path::Path) -> Result<(), String> {
+    /// Writes the canvas as a PNG file.
+    pub fn png(&self, path: &std::path::Path) -> Result<(), String> {
         let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), self.width as u32, self.height as u32);
         encoder.set_color(png::ColorType::Rgb);
@@ -265,7 +268,7 @@ fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, color: [f32; 3], alpha: f32)
 }
 
 /// Draws the scene (and plan) and writes the PNG.
-pub(crate) fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<(), String> {
     let text = std::fs::read_to_string(&args.scene).map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let problem = parse_problem(&text).map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let plan: Option<serde_json::Value> = match &args.plan {

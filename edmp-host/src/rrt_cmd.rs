@@ -11,7 +11,7 @@ use std::time::Instant;
 
 /// Arguments of `edmp-host rrt`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// The scene and problem (`edmp-scene/1` JSON).
     scene: PathBuf,
     /// Write the plan here instead of standard output.
@@ -26,7 +26,7 @@ pub(crate) struct Args {
 }
 
 /// Plans and writes the plan.
-pub(crate) fn run(args: &Args) -> Result<(), Failure> {
+pub fn run(args: &Args) -> Result<(), Failure> {
     let began = Instant::now();
     let text =
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;

@@ -23,7 +23,7 @@ const BATCH: usize = 12;
 
 /// Arguments of `edmp-host sample`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// Folder with one sub-folder of `edmp-scene/1` files per family (start and joint goal used).
     #[arg(long, default_value = "benchmarks/problems")]
     problems: PathBuf,
@@ -165,7 +165,7 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 }
 
 /// Runs the measurement and prints the table.
-pub(crate) fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<(), String> {
     let samplers = args
         .samplers
         .iter()

@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 /// A problem folder as written by `gen-suite`: each family's name and its first `per_family`
 /// `.json` files, families and files in name order.
-pub(crate) fn read_folder(root: &std::path::Path, per_family: usize) -> Result<Vec<(String, Vec<PathBuf>)>, String> {
+pub fn read_folder(root: &std::path::Path, per_family: usize) -> Result<Vec<(String, Vec<PathBuf>)>, String> {
     let list = |dir: &std::path::Path| -> Result<Vec<PathBuf>, String> {
         let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
             .map_err(|e| format!("{}: {e}", dir.display()))?
@@ -44,7 +44,7 @@ use std::path::PathBuf;
 
 /// Which committed suite to make.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum Suite {
+pub enum Suite {
     /// The four MpiNets (training) families: `benchmarks/problems`.
     InDistribution,
     /// The four kinds the prior never saw in training: `benchmarks/unseen`.
@@ -69,7 +69,7 @@ impl Suite {
 
 /// Arguments of `edmp-host gen-suite`.
 #[derive(Debug, clap::Args)]
-pub(crate) struct Args {
+pub struct Args {
     /// Which suite: its families and its default output folder.
     #[arg(long, value_enum, default_value_t = Suite::InDistribution)]
     suite: Suite,
@@ -107,7 +107,7 @@ pub(crate) fn solvable(family: Family, seed: u64, budget: Duration) -> Option<Pr
 }
 
 /// Writes the suite.
-pub(crate) fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<(), String> {
     let families: Vec<Family> = if args.family.is_empty() {
         args.suite.families().to_vec()
     } else {
