@@ -35,6 +35,7 @@ pub mod rng;
 pub mod robot;
 pub mod scene;
 pub mod search;
+pub mod shortcut;
 #[cfg(feature = "serde")]
 pub mod wire;
 

@@ -26,6 +26,7 @@ use crate::rng::Rng;
 use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
 use crate::search::SearchSpace;
+use crate::shortcut::{ShortcutConfig, ShortcutReport, shorten};
 
 /// When guidance runs and how often.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,6 +86,9 @@ pub struct PlanConfig {
     pub check: CheckConfig,
     /// The global stage when no candidate is free (`None`: EDMP alone, as the paper).
     pub global: Option<GlobalConfig>,
+    /// Shortening of the free winner over the exact checker ([`crate::shortcut`]; `None`: the
+    /// winner as the guides left it, as the paper).
+    pub shortcut: Option<ShortcutConfig>,
 }
 
 /// One candidate's verdict.
@@ -117,6 +121,9 @@ pub struct Plan<const B: usize> {
     pub stage: Stage,
     /// What the global stage's search did, when it ran.
     pub search: Option<SearchReport>,
+    /// What shortening did to the chosen candidate, when it ran (a free plan with
+    /// `PlanConfig::shortcut`).
+    pub shortcut: Option<ShortcutReport>,
 }
 
 /// Denoising steps of the shipped configuration ([`PlanConfig::DEFAULT`]).
@@ -149,6 +156,7 @@ impl PlanConfig {
         frame: BoxFrame::Obstacle,
         check: CheckConfig::DEFAULT,
         global: Some(GlobalConfig::DEFAULT),
+        shortcut: Some(ShortcutConfig::DEFAULT),
     };
 }
 
@@ -165,6 +173,7 @@ impl<const B: usize> Plan<B> {
             best: 0,
             stage: Stage::None,
             search: None,
+            shortcut: None,
         }
     }
 
@@ -194,6 +203,9 @@ impl<const B: usize> Plan<B> {
         }
         eat(self.best as u32);
         eat(self.stage as u32);
+        if let Some(s) = &self.shortcut {
+            eat(s.length_after.to_bits());
+        }
         hash
     }
 }
@@ -229,7 +241,7 @@ impl<const B: usize, const CAP: usize> Workspace<B, CAP> {
 
 /// Plans from `start` to `goal` in `scene` with `B` rows over `guides` (`B` a multiple of
 /// `guides.len()`), drawing every random number from `rng`: the same inputs give the same bits.
-/// [`denoise`] then [`select`], then [`finish`].
+/// [`denoise`] then [`select`], then [`finish`] and [`polish`].
 #[allow(clippy::too_many_arguments)]
 pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     scene: &Scene<N>,
@@ -246,6 +258,7 @@ pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     denoise(scene, start, goal, guides, config, rng, scratch, work, &mut plan.paths)?;
     judge(scene, start, goal, config, &mut plan)?;
     finish(scene, start, goal, guides, config, rng, scratch, work, &mut plan)?;
+    polish(scene, start, goal, config, rng, &mut plan)?;
     Ok(plan)
 }
 
@@ -263,10 +276,40 @@ pub fn finish<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     work: &mut Workspace<B, CAP>,
     plan: &mut Plan<B>,
 ) -> Result<(), Error> {
-    match &config.global {
-        Some(global) if !plan.is_free() => rescue(scene, start, goal, guides, config, global, rng, scratch, work, plan),
-        _ => Ok(()),
+    if let Some(global) = &config.global
+        && !plan.is_free()
+    {
+        rescue(scene, start, goal, guides, config, global, rng, scratch, work, plan)?;
     }
+    Ok(())
+}
+
+/// After [`finish`]: a free winner is shortened over the exact checker when `config.shortcut`
+/// asks for it ([`crate::shortcut::shorten`]), in place; its swept volume is recomputed.
+pub fn polish<const B: usize, const N: usize>(
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    config: &PlanConfig,
+    rng: &mut Rng,
+    plan: &mut Plan<B>,
+) -> Result<(), Error> {
+    if let Some(shortcut) = &config.shortcut
+        && plan.is_free()
+    {
+        let swept = CostConfig {
+            kind: CostKind::Swept,
+            inflation: Inflation::default(),
+            cylinder: config.cylinder,
+            frame: config.frame,
+        };
+        if let (Some(path), Some(verdict)) = (plan.paths.get_mut(plan.best), plan.verdicts.get_mut(plan.best)) {
+            let report = shorten(scene, start, goal, &config.check, shortcut, rng, path)?;
+            verdict.swept = trajectory_cost(scene, path, &swept, None)?;
+            plan.shortcut = Some(report);
+        }
+    }
+    Ok(())
 }
 
 /// One gradient step of every row's guide at diffusion step `t`, with the plan's step limit and
@@ -401,6 +444,7 @@ pub fn judge<const B: usize, const N: usize>(
     plan.best = pick(&plan.verdicts);
     plan.stage = if plan.is_free() { Stage::Diffusion } else { Stage::None };
     plan.search = None;
+    plan.shortcut = None;
     if !plan.is_free() && config.global.is_none() {
         rank_in_full(scene, config, plan)?;
     }
@@ -469,6 +513,7 @@ mod tests {
             frame: BoxFrame::Obstacle,
             check: CheckConfig::default(),
             global: None,
+            shortcut: None,
         }
     }
 

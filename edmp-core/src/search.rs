@@ -251,6 +251,20 @@ pub fn search<const CAP: usize>(
     }))
 }
 
+/// Random shortcuts on the polyline `path` over the caller's `edge_free` (see [`search`]): a
+/// pair of waypoints (i, j ≥ i + 2) is joined when the straight edge is free, dropping the
+/// waypoints between. Returns the new length and the oracle calls made (at most `attempts`).
+pub fn shortcut_polyline(
+    path: &mut [Joints<f32>],
+    attempts: u32,
+    rng: &mut Rng,
+    edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+) -> Result<(usize, u32), Error> {
+    let mut oracle = Oracle { edge_free, calls: 0 };
+    let n = shortcut(path, attempts, rng, &mut oracle)?;
+    Ok((n, oracle.calls))
+}
+
 /// The caller's `edge_free`, counted.
 struct Oracle<'f, F> {
     edge_free: &'f mut F,
@@ -511,8 +525,9 @@ where
     Ok(n)
 }
 
-/// `HORIZON` points evenly spaced by joint-space arc length along `path` (ends exact).
-fn resample_even(path: &[Joints<f32>]) -> Path {
+/// `HORIZON` points evenly spaced by joint-space arc length along `path` (ends exact). Public
+/// for the shortening of the chosen path ([`crate::shortcut`]).
+pub fn resample_even(path: &[Joints<f32>]) -> Path {
     let first = path.first().copied().unwrap_or_default();
     let last = path.last().copied().unwrap_or(first);
     let total: f32 = path.windows(2).map(segment_length).sum();

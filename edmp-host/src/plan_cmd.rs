@@ -11,7 +11,7 @@ use edmp_core::global::GlobalConfig;
 use edmp_core::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
-    PlanConfig, Workspace, denoise, finish, select,
+    PlanConfig, Workspace, denoise, finish, polish, select,
 };
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
@@ -79,6 +79,10 @@ pub struct Tuning {
     /// (EDMP alone, as the paper) instead of searching and reseeding the prior.
     #[arg(long)]
     no_global: bool,
+    /// Without shortening the free winner (shortcuts, resampling and smoothing over the exact
+    /// checker): the path as the guides left it, as the paper.
+    #[arg(long)]
+    no_shortcut: bool,
     /// Global stage: sampling iterations of the search before it gives up.
     #[arg(long, default_value_t = SearchConfig::DEFAULT.max_iterations)]
     search_iterations: u32,
@@ -123,6 +127,11 @@ impl Tuning {
                     ..GlobalConfig::DEFAULT
                 })
             },
+            shortcut: if self.no_shortcut {
+                None
+            } else {
+                PlanConfig::DEFAULT.shortcut
+            },
             ..PlanConfig::DEFAULT
         };
         if self.step_limit.is_nan() || self.step_limit <= 0.0 {
@@ -165,6 +174,11 @@ impl Tuning {
         } else {
             boxes.to_owned()
         };
+        let boxes = if self.no_shortcut {
+            format!("{boxes}, no shortcut")
+        } else {
+            boxes
+        };
         if self.ancestral {
             format!(
                 "ancestral K = 255, guidance on even t, {} refinement steps, {limit}{boxes}",
@@ -192,12 +206,14 @@ pub struct Planned {
     pub select_ms: f64,
     /// Milliseconds in the global stage.
     pub global_ms: f64,
+    /// Milliseconds shortening the winner.
+    pub shortcut_ms: f64,
 }
 
 impl Planned {
     /// Planning time in all, milliseconds.
     pub fn total_ms(&self) -> f64 {
-        self.ik_ms + self.denoise_ms + self.select_ms + self.global_ms
+        self.ik_ms + self.denoise_ms + self.select_ms + self.global_ms + self.shortcut_ms
     }
 }
 
@@ -242,12 +258,17 @@ pub fn plan_problem(problem: &Problem, guides: &[Guide], config: &PlanConfig, se
     )
     .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let global_ms = global_began.elapsed().as_secs_f64() * 1e3;
+    let shortcut_began = Instant::now();
+    polish(&problem.scene, &problem.start, &goal, config, &mut rng, &mut plan)
+        .map_err(|e| Failure::Input(format!("planner: {e}")))?;
+    let shortcut_ms = shortcut_began.elapsed().as_secs_f64() * 1e3;
     Ok(Planned {
         plan,
         ik_ms,
         denoise_ms,
         select_ms,
         global_ms,
+        shortcut_ms,
     })
 }
 
@@ -308,6 +329,12 @@ pub fn plan_document(
             "iterations": s.iterations,
             "segment_checks": s.segment_checks,
         })),
+        "shortcut": plan.shortcut.map(|s| json!({
+            "length_before": s.length_before,
+            "length_after": s.length_after,
+            "corners": s.corners,
+            "smoothing": s.smoothing,
+        })),
         "costs": {"swept_volume": plan.verdicts[plan.best].swept, "intersection_volume": intersection},
         "seed": seed,
         "timing_ms": {
@@ -316,6 +343,7 @@ pub fn plan_document(
             "denoise": planned.denoise_ms,
             "select": planned.select_ms,
             "global": planned.global_ms,
+            "shortcut": planned.shortcut_ms,
         },
     });
     if candidates {

@@ -1,0 +1,293 @@
+//! Shortening the chosen path: what makes a free trajectory as short and even as a smoothed
+//! RRT-Connect's without giving up the exact check.
+//!
+//! The guides buy clearance with detours and the refinement leaves uneven steps, so a free
+//! winner is often longer and rougher than it needs to be. [`shorten`] treats it as a
+//! polyline: a greedy pass that joins each kept waypoint to the farthest later one it can see
+//! (a straight segment that passes the exact checker; found by bisection, so about log₂ 50
+//! checks per kept waypoint), a few random shortcuts on what is left, resampling to [`HORIZON`] waypoints evenly by joint-space arc
+//! length (or through every corner when even spacing cuts one), then a few Laplacian passes.
+//! Every result is checked in full with the planner's own checker before it replaces the
+//! path; when a check fails the path keeps its last checked form, so a free plan stays free.
+//!
+//! Work is bounded by counts: at most `greedy_checks + attempts` segment checks, then at most
+//! `2 + smoothing` full trajectory checks. Randomness comes from the caller's [`Rng`]: deterministic.
+
+#![deny(
+    clippy::indexing_slicing,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::unreachable,
+    clippy::arithmetic_side_effects
+)]
+
+use crate::checker::{CheckConfig, check_segment, check_trajectory};
+use crate::error::Error;
+use crate::kinematics::Joints;
+use crate::prior::{HORIZON, Path};
+use crate::rng::Rng;
+use crate::scene::Scene;
+use crate::search::{resample_even, resample_through_vertices, shortcut_polyline};
+
+/// How hard [`shorten`] tries.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShortcutConfig {
+    /// Segment checks the greedy pass may spend; when they run out, the remaining waypoints
+    /// are kept as they are (their segments already passed).
+    pub greedy_checks: u32,
+    /// Random shortcut attempts after the greedy pass (one segment check each).
+    pub attempts: u32,
+    /// Laplacian passes after resampling (`x ← x/2 + (prev + next)/4` on the interior), each
+    /// kept only when the whole trajectory still passes the checker.
+    pub smoothing: u8,
+}
+
+impl ShortcutConfig {
+    /// The shipped setting: as many shortcut attempts as the RRT-Connect baseline.
+    pub const DEFAULT: Self = Self {
+        greedy_checks: 64,
+        attempts: 8,
+        smoothing: 2,
+    };
+}
+
+impl Default for ShortcutConfig {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// What [`shorten`] did to the chosen path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShortcutReport {
+    /// Joint-space length (sum of Euclidean steps, radians) before.
+    pub length_before: f32,
+    /// Joint-space length after (equal to `length_before` when nothing passed the checker).
+    pub length_after: f32,
+    /// Shortcuts that joined two waypoints.
+    pub corners: u8,
+    /// Laplacian passes kept.
+    pub smoothing: u8,
+}
+
+/// Shortens the free trajectory `path` from `start` to `goal` in `scene`, in place; `path`
+/// changes only to trajectories that pass `check` in full (the same rule as the selection:
+/// `end_margin` near the ends, `margin` elsewhere). Call it on a path that passed `check`.
+#[allow(clippy::too_many_arguments)]
+pub fn shorten<const N: usize>(
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    check: &CheckConfig,
+    config: &ShortcutConfig,
+    rng: &mut Rng,
+    path: &mut Path,
+) -> Result<ShortcutReport, Error> {
+    let length_before = length(path);
+    let mut report = ShortcutReport {
+        length_before,
+        length_after: length_before,
+        corners: 0,
+        smoothing: 0,
+    };
+    let free = |p: &Path| -> Result<bool, Error> { Ok(check_trajectory(scene, p, check, true)?.is_free()) };
+    let mut polyline = *path;
+    let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| check_segment(scene, a, b, [start, goal], check);
+    let n = greedy(&mut polyline, config.greedy_checks, &mut edge_free)?;
+    let (n, _) = match polyline.get_mut(..n) {
+        Some(kept) => shortcut_polyline(kept, config.attempts, rng, &mut edge_free)?,
+        None => (n, 0),
+    };
+    let Some(corners) = polyline.get(..n) else {
+        return Ok(report);
+    };
+    // An unchanged polyline is the checked path itself: nothing to resample.
+    if n < HORIZON {
+        let even = resample_even(corners);
+        let candidate = if free(&even)? {
+            Some(even)
+        } else {
+            match resample_through_vertices(corners) {
+                Some(p) if free(&p)? => Some(p),
+                _ => None,
+            }
+        };
+        let Some(candidate) = candidate else {
+            return Ok(report);
+        };
+        *path = candidate;
+        report.corners = u8::try_from(HORIZON.saturating_sub(n)).unwrap_or(u8::MAX);
+    }
+    for _ in 0..config.smoothing {
+        let smoothed = laplacian(path);
+        if !free(&smoothed)? {
+            break;
+        }
+        *path = smoothed;
+        report.smoothing = report.smoothing.saturating_add(1);
+    }
+    report.length_after = length(path);
+    Ok(report)
+}
+
+/// Joins each kept waypoint of `path` to the farthest later waypoint it sees (bisection over
+/// the later waypoints: the last one first, then halves; visibility is not monotone, so this
+/// finds a far free one, not always the farthest), in place. Returns the number kept. The
+/// segment to the next waypoint is never asked: the path passed the checker.
+fn greedy(
+    path: &mut Path,
+    budget: u32,
+    edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+) -> Result<usize, Error> {
+    let last = HORIZON.saturating_sub(1);
+    let (mut kept, mut i, mut checks) = (0usize, 0usize, 0u32);
+    while i < last {
+        let Some(from) = path.get(i).copied() else { break };
+        let (mut lo, mut hi) = (i.saturating_add(1), last);
+        let mut probe = hi;
+        while lo < hi && checks < budget {
+            let Some(to) = path.get(probe).copied() else { break };
+            checks = checks.saturating_add(1);
+            if edge_free(&from, &to)? {
+                lo = probe;
+                if probe == hi {
+                    break;
+                }
+            } else {
+                hi = probe.saturating_sub(1);
+            }
+            probe = lo.saturating_add(hi.saturating_sub(lo).saturating_add(1) / 2);
+        }
+        kept = kept.saturating_add(1);
+        if let Some(q) = path.get(lo).copied()
+            && let Some(slot) = path.get_mut(kept)
+        {
+            *slot = q;
+        }
+        i = lo;
+    }
+    Ok(kept.saturating_add(1))
+}
+
+/// One Laplacian pass over the interior waypoints (the ends stay exact).
+fn laplacian(path: &Path) -> Path {
+    let mut out = *path;
+    for (slot, w) in out.iter_mut().skip(1).zip(path.windows(3)) {
+        if let [a, b, c] = w {
+            for (v, ((x, y), z)) in slot.iter_mut().zip(a.iter().zip(b).zip(c)) {
+                *v = 0.5 * y + 0.25 * (x + z);
+            }
+        }
+    }
+    out
+}
+
+/// Joint-space length: the sum of the Euclidean steps.
+fn length(path: &Path) -> f32 {
+    path.windows(2)
+        .map(|w| match w {
+            [a, b] => libm::sqrtf(a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()),
+            _ => 0.0,
+        })
+        .sum()
+}
+
+#[cfg(test)]
+#[allow(
+    clippy::indexing_slicing,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::arithmetic_side_effects
+)]
+mod tests {
+    use super::*;
+    use crate::scene::Obstacle;
+
+    const START: Joints<f32> = [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
+    const GOAL: Joints<f32> = [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
+
+    /// A detour through a raised joint 2 and 4: free in an empty scene, twice as long as needed.
+    fn detour() -> Path {
+        let mut path: Path = core::array::from_fn(|i| {
+            let s = i as f32 / (HORIZON - 1) as f32;
+            let bump = libm::sinf(core::f32::consts::PI * s);
+            let mut q = [0.0; 7];
+            for (j, v) in q.iter_mut().enumerate() {
+                *v = START[j] + (GOAL[j] - START[j]) * s;
+            }
+            q[1] -= 0.6 * bump;
+            q[3] += 0.5 * bump;
+            q
+        });
+        path[0] = START;
+        path[HORIZON - 1] = GOAL;
+        path
+    }
+
+    fn floor() -> Scene<4> {
+        let mut s = Scene::new();
+        s.push(Obstacle::cuboid([0.5, 0.0, -0.01], [1.2, 1.6, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())
+            .unwrap();
+        s
+    }
+
+    #[test]
+    fn a_free_detour_becomes_shorter_and_stays_free() {
+        let scene = floor();
+        let check = CheckConfig::default();
+        let mut path = detour();
+        assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
+        let report = shorten(&scene, &START, &GOAL, &check, &ShortcutConfig::DEFAULT, &mut Rng::new(1), &mut path).unwrap();
+        assert!(report.length_after < 0.8 * report.length_before, "{report:?}");
+        assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
+        assert_eq!(path[0], START);
+        assert_eq!(path[HORIZON - 1], GOAL);
+        assert!((report.length_after - length(&path)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_wall_keeps_the_detour_that_passes_it() {
+        // A wall across the straight line: shortcuts through it are refused by the checker.
+        let mut scene = floor();
+        scene
+            .push(Obstacle::cuboid([0.55, 0.0, 0.45], [0.3, 0.02, 0.5], [1.0, 0.0, 0.0, 0.0]).unwrap())
+            .unwrap();
+        let check = CheckConfig::default();
+        let straight: Path = core::array::from_fn(|i| {
+            let s = i as f32 / (HORIZON - 1) as f32;
+            core::array::from_fn(|j| START[j] + (GOAL[j] - START[j]) * s)
+        });
+        assert!(!check_trajectory(&scene, &straight, &check, true).unwrap().is_free());
+        let mut path = detour();
+        assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free(), "the detour passes the wall");
+        shorten(&scene, &START, &GOAL, &check, &ShortcutConfig::DEFAULT, &mut Rng::new(2), &mut path).unwrap();
+        assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
+    }
+
+    #[test]
+    fn deterministic_for_a_seed() {
+        let scene = floor();
+        let check = CheckConfig::default();
+        let run = |seed| {
+            let mut path = detour();
+            shorten(&scene, &START, &GOAL, &check, &ShortcutConfig::DEFAULT, &mut Rng::new(seed), &mut path).unwrap();
+            path
+        };
+        assert_eq!(run(7), run(7));
+    }
+
+    #[test]
+    fn laplacian_keeps_the_ends_and_a_straight_line() {
+        let straight: Path = core::array::from_fn(|i| [i as f32 * 0.01; 7]);
+        let s = laplacian(&straight);
+        assert_eq!(s[0], straight[0]);
+        assert_eq!(s[HORIZON - 1], straight[HORIZON - 1]);
+        for (a, b) in s.iter().zip(&straight) {
+            for (x, y) in a.iter().zip(b) {
+                assert!((x - y).abs() < 1e-6);
+            }
+        }
+    }
+}
