@@ -27,6 +27,16 @@ pub enum Error {
         /// Index of the offending joint.
         joint: u8,
     },
+    /// A velocity or acceleration scale of a trajectory is not in (0, 1] (NaN included).
+    BadScale,
+    /// A waypoint joint is finite but beyond what a trajectory can be timed over
+    /// (`trajectory::spline::MAX_JOINT_MAGNITUDE`).
+    OutOfRange {
+        /// Index of the offending joint.
+        joint: u8,
+    },
+    /// A trajectory's fixed grid has fewer points than its path has spans.
+    GridTooSmall,
 }
 
 impl fmt::Display for Error {
@@ -38,6 +48,9 @@ impl fmt::Display for Error {
             Self::BadParameter => f.write_str("a parameter is negative or not finite"),
             Self::SegmentTooLong => f.write_str("consecutive waypoints are too far apart to interpolate"),
             Self::OutsideLimits { joint } => write!(f, "joint {joint} is outside the soft limits"),
+            Self::BadScale => f.write_str("a velocity or acceleration scale is not in (0, 1]"),
+            Self::OutOfRange { joint } => write!(f, "joint {joint} of a waypoint is beyond +-100 rad"),
+            Self::GridTooSmall => f.write_str("the trajectory grid is too small for the path"),
         }
     }
 }

@@ -36,6 +36,7 @@ pub mod robot;
 pub mod scene;
 pub mod search;
 pub mod shortcut;
+pub mod trajectory;
 #[cfg(feature = "serde")]
 pub mod wire;
 

@@ -5,6 +5,7 @@
 
 use crate::Failure;
 use crate::json::{Problem, joint_goal, parse_problem};
+use crate::timed::{TimedArgs, TimedRequest, trajectory_document};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{BoxFrame, Inflation};
 use edmp_core::global::GlobalConfig;
@@ -46,6 +47,8 @@ pub struct Args {
     guides: Vec<u8>,
     #[command(flatten)]
     tuning: Tuning,
+    #[command(flatten)]
+    timed: TimedArgs,
 }
 
 /// The planner's knobs, shared by `plan` and `bench`.
@@ -365,6 +368,24 @@ pub fn plan_document(
     Ok(out)
 }
 
+/// Adds the `trajectory` field (and `timing_ms.trajectory`) to a plan document when the plan
+/// is free; `false` when it collides (a colliding path is not timed).
+pub fn add_trajectory(
+    doc: &mut serde_json::Value,
+    problem: &Problem,
+    plan: &Plan<ROWS>,
+    config: &PlanConfig,
+    request: &TimedRequest,
+) -> Result<bool, Failure> {
+    let Some(path) = plan.paths.get(plan.best).filter(|_| plan.is_free()) else {
+        return Ok(false);
+    };
+    let began = Instant::now();
+    doc["trajectory"] = trajectory_document(&problem.scene, path, &config.check, request)?;
+    doc["timing_ms"]["trajectory"] = json!(began.elapsed().as_secs_f64() * 1e3);
+    Ok(true)
+}
+
 /// Plans and writes the plan.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let began = Instant::now();
@@ -373,10 +394,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let guides = chosen_guides(&args.guides)?;
     let config = args.tuning.config()?;
+    let timed = args.timed.request()?;
 
     let planned = plan_problem(&problem, &guides, &config, args.seed)?;
     let total_ms = began.elapsed().as_secs_f64() * 1e3;
-    let out = plan_document(
+    let mut out = plan_document(
         &problem,
         &planned,
         &guides,
@@ -386,6 +408,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         total_ms,
     )?;
     let plan = &planned.plan;
+    if let Some(request) = &timed
+        && !add_trajectory(&mut out, &problem, plan, &config, request)?
+    {
+        eprintln!("edmp-host: no trajectory: the plan collides, so it is not timed");
+    }
     let text = serde_json::to_string_pretty(&out).map_err(|e| Failure::Input(e.to_string()))? + "\n";
     match &args.output {
         Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?,
