@@ -46,8 +46,9 @@ use crate::robot::JOINTS;
 use crate::scene::Scene;
 use profile::{Law, Profile};
 
-/// Most grid points per span: more buys little time and costs work.
-pub const MAX_GRID_PER_SPAN: usize = 8;
+/// Most grid points per span: 8 gave durations 4 % shorter (0.1 s on a 2.8 s plan) for 2.8x the
+/// work (3.7 against 1.3 ms per plan, `cargo bench -p edmp-core --bench trajectory`).
+pub const MAX_GRID_PER_SPAN: usize = 4;
 /// Grid capacity that gives a 50-waypoint path [`MAX_GRID_PER_SPAN`] points per span in either
 /// shape (the polyline's `3·50 − 3 = 147` spans, plus the last point).
 pub const DEFAULT_GRID: usize = MAX_GRID_PER_SPAN * (3 * HORIZON - 3) + 1;
