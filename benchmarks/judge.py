@@ -16,7 +16,8 @@ PyBullet 3.2.7 and none of the project's code:
 The robot is pybullet_data's `franka_panda/panda.urdf`, loaded only after checking that it and
 its collision meshes are byte-identical to the repository's `weights/panda/` (the repository
 copy lacks the visual meshes PyBullet needs to load it), with a fixed base at the origin and
-both fingers at 0.025 m. Obstacles and the held object are true PyBullet primitives (boxes,
+both finger joints at the scene's `gripper.finger` (0 <= w <= 0.04 m; 0.025 m when the field
+is absent) for the whole plan. Obstacles and the held object are true PyBullet primitives (boxes,
 cylinders along local z, spheres); the held object is its own body whose pose is reset from
 the `panda_hand` link's world pose at every state. States are set with `resetJointState` (no
 physics stepping), followed by `performCollisionDetection`, then the queries.
@@ -92,7 +93,8 @@ import pybullet_data  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 URDF = ROOT / "weights" / "panda" / "panda.urdf"
-FINGER_OPENING = 0.025
+FINGER_OPENING = 0.025  # each finger joint, when a scene has no `gripper` field
+FINGER_LIMITS = (0.0, 0.04)  # the URDF's <limit> of both finger joints
 JOINT_TOLERANCE = 1e-4
 LIMIT_TOLERANCE = 1e-5
 POSITION_TOLERANCE = 0.005
@@ -127,6 +129,7 @@ class Robot:
     held_partners: list[int]  # links the held object may not touch (not neighbours of the hand group)
     hand: int
     tcp: int
+    finger: float = FINGER_OPENING  # both finger joints, set from each scene's `gripper`
 
 
 def level(name: str) -> int:
@@ -197,11 +200,25 @@ def spawn(robot: Robot, o: dict[str, Any]) -> int:
     return p.createMultiBody(0, shape, basePosition=o["center"], baseOrientation=orientation, physicsClientId=c)
 
 
+def finger_opening(scene: dict[str, Any]) -> float:
+    """The scene's `gripper.finger` (metres, each finger joint), FINGER_OPENING when absent;
+    ValueError (bad input) outside the URDF's limits or for unknown fields."""
+    gripper = scene.get("gripper")
+    if gripper is None:
+        return FINGER_OPENING
+    if not isinstance(gripper, dict) or set(gripper) != {"finger"}:
+        raise ValueError(f"gripper: expected {{\"finger\": w}}, found {gripper!r}")
+    w = gripper["finger"]
+    if isinstance(w, bool) or not isinstance(w, (int, float)) or not FINGER_LIMITS[0] <= w <= FINGER_LIMITS[1]:
+        raise ValueError(f"gripper.finger: {w!r} outside [{FINGER_LIMITS[0]}, {FINGER_LIMITS[1]}]")
+    return float(w)
+
+
 def set_state(robot: Robot, q: np.ndarray) -> None:
     for j, value in zip(robot.revolute, q):
         p.resetJointState(robot.body, j, float(value), physicsClientId=robot.client)
     for j in robot.prismatic:
-        p.resetJointState(robot.body, j, FINGER_OPENING, physicsClientId=robot.client)
+        p.resetJointState(robot.body, j, robot.finger, physicsClientId=robot.client)
 
 
 def link_pose(robot: Robot, link: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
@@ -283,6 +300,7 @@ def quaternion_angle(q1_xyzw: Any, q2_xyzw: Any) -> float:
 def judge(robot: Robot, scene: dict[str, Any], plan: dict[str, Any]) -> dict[str, Any]:
     """The verdict on one plan: `solved`, the list of `failed` rules and their details."""
     verdict: dict[str, Any] = {"solved": False, "failed": []}
+    robot.finger = finger_opening(scene)
     waypoints = plan.get("waypoints")
     try:
         w = np.asarray(waypoints, dtype=np.float64)
@@ -341,7 +359,8 @@ def judge(robot: Robot, scene: dict[str, Any], plan: dict[str, Any]) -> dict[str
 
 def walk(robot: Robot, scene: dict[str, Any], w: np.ndarray, query: Any, **kwargs: Any) -> Any:
     """Yields (segment, step, steps, query result) at every checked state, the scene's bodies
-    spawned for the walk and removed after it."""
+    spawned for the walk and removed after it, the fingers at the scene's opening."""
+    robot.finger = finger_opening(scene)
     obstacles = [spawn(robot, o) for o in scene.get("obstacles", [])]
     held, held_pose = None, None
     if scene.get("held_object"):

@@ -267,3 +267,43 @@ def test_bad_input_is_exit_2_not_a_false_success(tmp_path):
     assert judge.main(["--problems", str(problems), "--plans", str(plans), "--jobs", "1", "--no-progress"]) == 2
     write(plans / "cubby" / "005.json", PLAN)  # no such problem
     assert judge.main(["--problems", str(problems), "--plans", str(plans), "--jobs", "1", "--no-progress"]) == 2
+
+
+def plate_between_the_fingers(robot, q: list[float]) -> dict:
+    """A 1 cm x 2 cm x 2 cm plate between the fingers at q (9.5 cm along the hand's z, 2 cm
+    across its y), turned with the hand."""
+    judge.set_state(robot, np.array(q))
+    hand_pos, hand_quat = judge.link_pose(robot, robot.hand)
+    center, _ = judge.p.multiplyTransforms(hand_pos, hand_quat, [0, 0, 0.095], [0, 0, 0, 1])
+    x, y, z, w = hand_quat
+    return {"type": "cuboid", "center": list(center), "dims": [0.01, 0.02, 0.02], "quaternion": [w, x, y, z]}
+
+
+def test_the_fingers_sit_at_the_scenes_opening(robot):
+    plate = plate_between_the_fingers(robot, READY)
+    scene = empty_scene(READY, READY, [plate])
+    for w in (0.04, 0.025, 0.015):
+        assert judge.judge(robot, scene | {"gripper": {"finger": w}}, {"waypoints": constant(READY)})["solved"], w
+    assert judge.judge(robot, scene, {"waypoints": constant(READY)})["solved"]  # absent: 0.025
+    v = judge.judge(robot, scene | {"gripper": {"finger": 0.0}}, {"waypoints": constant(READY)})
+    assert v["failed"] == ["contact"]
+    assert v["first_contact"]["link"] in ("panda_leftfinger", "panda_rightfinger")
+    # The finger joints really are at w: each finger link 2w apart along the hand's y.
+    robot.finger = 0.04
+    judge.set_state(robot, np.array(READY))
+    assert [judge.p.getJointState(robot.body, j, physicsClientId=robot.client)[0] for j in robot.prismatic] == [0.04, 0.04]
+    left, right = (judge.link_pose(robot, j)[0] for j in robot.prismatic)
+    assert math.dist(left, right) == pytest.approx(0.08, abs=1e-6)
+    robot.finger = judge.FINGER_OPENING
+
+
+def test_a_bad_gripper_is_bad_input(robot, tmp_path):
+    for gripper in ({"finger": 0.05}, {"finger": -0.01}, {"finger": "open"}, {"finger": True}, {"fingers": 0.04}, {}, 0.04):
+        with pytest.raises(ValueError):
+            judge.finger_opening({"gripper": gripper})
+    assert judge.finger_opening({}) == judge.FINGER_OPENING
+    assert judge.finger_opening({"gripper": {"finger": 0}}) == 0.0
+    problems, plans = tmp_path / "problems", tmp_path / "plans"
+    write(problems / "cubby" / "003.json", SCENE | {"gripper": {"finger": 0.05}})
+    write(plans / "cubby" / "003.json", PLAN)
+    assert judge.main(["--problems", str(problems), "--plans", str(plans), "--jobs", "1", "--no-progress"]) == 2

@@ -107,7 +107,7 @@ pub mod reference {
     use core::hash::{Hash, Hasher};
     use edmp_core::cost::{CostConfig, CostKind};
     use edmp_core::geometry::{BoxFrame, box_dims};
-    use edmp_core::kinematics::forward;
+    use edmp_core::kinematics::forward_with;
     use edmp_core::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
     use edmp_core::scene::Scene;
     use nalgebra::Vector3;
@@ -167,7 +167,8 @@ pub mod reference {
 
     /// Every moving robot box's 8 world corners at `q` (bodies off the root, then the held object).
     fn robot_corners(q: &[f64; JOINTS], scene: &Scene<16>, cfg: &CostConfig) -> Vec<Vec<Vector3<f64>>> {
-        let k = forward(q).expect("finite");
+        // The scene's finger opening (in f64, from the scene's f32) places the finger boxes.
+        let k = forward_with(q, f64::from(scene.gripper())).expect("finite, opening validated");
         let mut out = Vec::new();
         for b in 0..BODIES {
             if PANDA.bodies[b].frame == 0 {

@@ -21,7 +21,10 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     );
     wl(
         w,
-        &format!("// Prismatic finger joints are frozen at {FINGER_OPENING} m (shared/spec/formats.md)."),
+        &format!(
+            "// Finger frames are their fixed transform at opening 0 plus `slide` times the opening w, an input \
+             (the scene's `gripper.finger`, default {FINGER_OPENING} m, shared/spec/formats.md)."
+        ),
     );
     wl(w, "");
     wl(w, "/// Number of actuated (revolute) joints, in chain order.");
@@ -46,6 +49,26 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         ),
     );
     wl(w, &format!("pub const HAND_FRAME: usize = {};", chain.hand));
+    wl(
+        w,
+        "/// Default opening of each finger, metres: what an absent `gripper` field means (shared/spec/formats.md).",
+    );
+    wl(
+        w,
+        &format!("pub const FINGER_OPENING_DEFAULT: f32 = {};", lit(FINGER_OPENING)),
+    );
+    let [lower, upper] = chain.finger_limits;
+    let driver = &chain.finger_joint;
+    wl(
+        w,
+        &format!("/// Smallest opening of each finger, metres: `<limit lower>` of `{driver}`."),
+    );
+    wl(w, &format!("pub const FINGER_OPENING_MIN: f32 = {};", lit(lower)));
+    wl(
+        w,
+        &format!("/// Largest opening of each finger, metres: `<limit upper>` of `{driver}`."),
+    );
+    wl(w, &format!("pub const FINGER_OPENING_MAX: f32 = {};", lit(upper)));
     wl(w, "/// URDF link name of each frame.");
     let names: Vec<_> = chain.frames.iter().map(|f| format!("{:?}", f.name)).collect();
     wl(
@@ -81,6 +104,7 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     wl(w, "            frames: [");
     for (i, f) in chain.frames.iter().enumerate() {
         wl(w, &format!("                // [{i}] `{}`: {}", f.name, f.provenance));
+        let mut slide = None;
         let (joint, axis, fixed, cos, sin) = match &f.motion {
             Motion::Fixed => (
                 "None".to_string(),
@@ -89,6 +113,16 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
                 [[0.0; 3]; 3],
                 [[0.0; 3]; 3],
             ),
+            Motion::Finger { axis, slide: s } => {
+                slide = Some(*s);
+                (
+                    "None".to_string(),
+                    *axis,
+                    f.origin_rotation,
+                    [[0.0; 3]; 3],
+                    [[0.0; 3]; 3],
+                )
+            }
             Motion::Revolute { joint, axis } => {
                 // R_origin · Rot(a, q) = R_o·a·aᵀ + cos q · R_o·(I − a·aᵀ) + sin q · R_o·[a]×.
                 let aat = [0, 1, 2].map(|r| [0, 1, 2].map(|c| axis[r] * axis[c]));
@@ -109,6 +143,10 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         wl(w, &format!("                    rot_fixed: {},", mat3(&fixed)));
         wl(w, &format!("                    rot_cos: {},", mat3(&cos)));
         wl(w, &format!("                    rot_sin: {},", mat3(&sin)));
+        match slide {
+            Some(s) => wl(w, &format!("                    slide: Some({}),", vec3(&s))),
+            None => wl(w, "                    slide: None,"),
+        }
         wl(w, "                },");
     }
     wl(w, "            ],");
@@ -186,6 +224,13 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         w,
         &format!("            hard_upper: [{}],", limits(&|i| chain.joints[i].hard[1])),
     );
+    wl(
+        w,
+        &format!("            // The finger opening: the spec's default, and `<limit lower / upper>` of `{driver}`."),
+    );
+    wl(w, &format!("            finger_default: {},", lit(FINGER_OPENING)));
+    wl(w, &format!("            finger_lower: {},", lit(lower)));
+    wl(w, &format!("            finger_upper: {},", lit(upper)));
     wl(w, "        }");
     wl(w, "    };");
     wl(w, "}");

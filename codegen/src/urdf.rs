@@ -5,8 +5,9 @@ use crate::math::{self, Mat3, Vec3};
 use crate::mesh::{self, OrientedBox};
 use std::path::{Path, PathBuf};
 
-/// Opening of each Panda finger, held fixed: the MpiNets / robofin convention that
-/// `shared/spec/formats.md` makes part of the contract.
+/// Default opening of each Panda finger: the MpiNets / robofin convention that
+/// `shared/spec/formats.md` makes the value of an absent `gripper` field. The opening itself is
+/// an input (the scene's `gripper.finger`), not folded into the tables.
 pub const FINGER_OPENING: f64 = 0.025;
 /// The URDF link that is the tool centre point (`spec/formats.md`).
 pub const TCP_LINK: &str = "panda_grasptarget";
@@ -16,8 +17,17 @@ pub const HAND_LINK: &str = "panda_hand";
 /// How a frame moves relative to its parent.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Motion {
-    /// Rigidly attached (fixed joints, and the fingers held at [`FINGER_OPENING`]).
+    /// Rigidly attached (fixed joints).
     Fixed,
+    /// A finger on a prismatic joint: it slides by `slide · w` from its origin, `w` being the
+    /// gripper opening (the driving finger joint's value; a `<mimic>` joint follows it).
+    Finger {
+        /// Unit joint axis in the child frame, as the URDF gives it.
+        axis: Vec3,
+        /// `R_origin · axis · multiplier`: the frame's displacement per metre of opening, in
+        /// the parent frame.
+        slide: Vec3,
+    },
     /// Turns about `axis` (in its own frame) by the actuated joint `joint`.
     Revolute {
         /// Index among the actuated joints, in chain order.
@@ -36,7 +46,8 @@ pub struct Frame {
     pub parent: usize,
     /// Rotation of the joint origin relative to the parent frame.
     pub origin_rotation: Mat3,
-    /// Translation of the joint origin relative to the parent frame (finger opening folded in).
+    /// Translation of the joint origin relative to the parent frame (for a finger: at opening
+    /// 0, a mimic joint's offset folded in).
     pub origin_translation: Vec3,
     /// How the frame moves.
     pub motion: Motion,
@@ -88,6 +99,10 @@ pub struct Chain {
     pub tcp: usize,
     /// Index of the hand frame.
     pub hand: usize,
+    /// The driving finger joint (the one the others `<mimic>`): its value is the opening.
+    pub finger_joint: String,
+    /// `<limit lower upper>` of the driving finger joint: the range of the opening.
+    pub finger_limits: [f64; 2],
     /// Every file that was read (for `cargo:rerun-if-changed`).
     pub inputs: Vec<PathBuf>,
 }
@@ -113,6 +128,10 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
         provenance: format!("root link `{}`: the world frame", root.name),
     }];
     let mut joints = Vec::new();
+    // Prismatic joints that drive themselves (name, limits), and every prismatic joint with
+    // the joint it follows.
+    let mut fingers: Vec<(String, [f64; 2])> = Vec::new();
+    let mut drivers: Vec<(String, String)> = Vec::new();
     // Breadth-first in declaration order, so every parent precedes its children.
     let mut next = 0;
     while next < frames.len() {
@@ -152,16 +171,36 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
                 ),
                 urdf_rs::JointType::Prismatic => {
                     let axis = normalised(&joint.axis.xyz, &joint.name)?;
-                    // d = R_origin · axis · opening, folded into the origin.
-                    let shift = math::mul_vec(&origin_rotation, &axis);
-                    for (o, s) in origin_translation.iter_mut().zip(shift) {
-                        *o += s * FINGER_OPENING;
+                    // Opening w: this joint's value is `multiplier · w + offset` (1 and 0 for
+                    // the driving joint). The offset is folded into the origin; the frame then
+                    // moves by R_origin · axis · multiplier per metre of w.
+                    let (multiplier, offset, driver) = match &joint.mimic {
+                        Some(m) => (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0), m.joint.clone()),
+                        None => {
+                            fingers.push((joint.name.clone(), [joint.limit.lower, joint.limit.upper]));
+                            (1.0, 0.0, joint.name.clone())
+                        }
+                    };
+                    drivers.push((joint.name.clone(), driver.clone()));
+                    let direction = math::mul_vec(&origin_rotation, &axis);
+                    for (o, d) in origin_translation.iter_mut().zip(direction) {
+                        *o += d * offset;
                     }
-                    let provenance = format!(
-                        "prismatic `{}` held at {FINGER_OPENING} m along axis {axis:?}: origin xyz={xyz:?} rpy={rpy:?}",
-                        joint.name
-                    );
-                    (Motion::Fixed, provenance)
+                    let slide = direction.map(|d| d * multiplier);
+                    let provenance = if driver == joint.name {
+                        format!(
+                            "prismatic `{}`, the gripper opening w, axis {axis:?}: origin xyz={xyz:?} rpy={rpy:?}, \
+                             slides by w along R_origin·axis",
+                            joint.name
+                        )
+                    } else {
+                        format!(
+                            "prismatic `{}`, mimics `{driver}` (multiplier {multiplier}, offset {offset}), axis {axis:?}: \
+                             origin xyz={xyz:?} rpy={rpy:?}, slides by w along R_origin·axis·multiplier",
+                            joint.name
+                        )
+                    };
+                    (Motion::Finger { axis, slide }, provenance)
                 }
                 ref other => return Err(format!("joint `{}`: unsupported type {other:?}", joint.name)),
             };
@@ -181,6 +220,33 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
             "{} links but {} reachable from the root",
             robot.links.len(),
             frames.len()
+        ));
+    }
+
+    // One opening for the whole gripper: one driving finger joint, every other one mimics it.
+    let (finger_joint, finger_limits) = match fingers.as_slice() {
+        [] => return Err("no prismatic finger joint: the gripper opening has nothing to drive".to_owned()),
+        [(name, limits)] => {
+            if let Some((follower, driver)) = drivers.iter().find(|(_, d)| d != name) {
+                return Err(format!(
+                    "prismatic `{follower}` follows `{driver}`, not the gripper's driving joint `{name}`"
+                ));
+            }
+            if !(limits[0].is_finite() && limits[1].is_finite() && limits[0] <= limits[1]) {
+                return Err(format!("prismatic `{name}`: limits {limits:?} are not a range"));
+            }
+            (name.clone(), *limits)
+        }
+        more => {
+            let names: Vec<_> = more.iter().map(|(n, _)| n.as_str()).collect();
+            return Err(format!(
+                "prismatic joints {names:?} each drive themselves: one opening needs one driver (the others <mimic> it)"
+            ));
+        }
+    };
+    if !(finger_limits[0] <= FINGER_OPENING && FINGER_OPENING <= finger_limits[1]) {
+        return Err(format!(
+            "the default finger opening {FINGER_OPENING} m is outside the URDF's limits {finger_limits:?}"
         ));
     }
 
@@ -239,6 +305,8 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
         bodies,
         tcp,
         hand,
+        finger_joint,
+        finger_limits,
         inputs,
     })
 }

@@ -15,7 +15,7 @@
 use crate::convex::{Hull, Primitive};
 use crate::error::Error;
 use crate::gjk::{apart, distance_lower_bound};
-use crate::kinematics::{Joints, Kinematics, forward};
+use crate::kinematics::{Joints, Kinematics, forward_with};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Scene, Shape};
 use nalgebra::{Matrix3, Vector3};
@@ -138,23 +138,23 @@ fn level(frame: usize) -> u8 {
     let mut f = frame.min(FRAMES - 1);
     let mut joints = 0u8;
     for _ in 0..FRAMES {
-        if PANDA.frames[f].joint.is_some() {
-            joints += 1;
+        let Some(spec) = PANDA.frames.get(f) else { break };
+        if spec.joint.is_some() {
+            joints = joints.saturating_add(1);
         }
         if f == 0 {
             break;
         }
-        f = PANDA.frames[f].parent;
+        f = spec.parent;
     }
     joints
 }
 
 fn body_level(body: usize) -> u8 {
-    if body < BODIES {
-        level(PANDA.bodies[body].frame)
-    } else {
-        level(HAND_FRAME)
-    }
+    PANDA
+        .bodies
+        .get(body)
+        .map_or_else(|| level(HAND_FRAME), |b| level(b.frame))
 }
 
 fn moves(body: usize) -> bool {
@@ -301,7 +301,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
     /// The first contact at configuration `q`, if any; `margin` is the obstacle clearance
     /// this state must keep.
     fn contact_at(&mut self, q: &Joints<f32>, margin: f32) -> Result<Option<Contact>, Error> {
-        let k = forward(q)?;
+        let k = forward_with(q, self.scene.gripper())?;
         let self_margin = self.config.self_margin;
         let held = self.scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME]));
         let center: [Vector3<f32>; SLOTS] = core::array::from_fn(|b| match (k.boxes.get(b), &held) {
@@ -380,7 +380,7 @@ pub fn check_end<const N: usize>(
 /// object) to the nearest obstacle: zero when something may touch. Obstacles only; for
 /// diagnostics and for choosing among states that are all free.
 pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f32, Error> {
-    let k = forward(q)?;
+    let k = forward_with(q, scene.gripper())?;
     let held = scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME]));
     let mut best = f32::INFINITY;
     for o in scene.obstacles().iter().map(Primitive::obstacle) {
@@ -506,10 +506,48 @@ fn interpolate(a: &Joints<f32>, b: &Joints<f32>, step: u32, steps: u32) -> Joint
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kinematics::forward;
     use crate::scene::Obstacle;
 
     const READY: [f32; 7] = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
     const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
+
+    /// A thin plate between the fingers (2 cm across the hand's y, 1 cm thick, 2 cm tall, centred
+    /// 9.5 cm from the hand on its z, turned with the hand), as one obstacle.
+    fn plate_between_the_fingers() -> Scene<4> {
+        let k = forward(&READY).unwrap();
+        let hand = &k.frames[HAND_FRAME];
+        let center = hand.transform_point(&Vector3::new(0.0, 0.0, 0.095));
+        let mut scene = Scene::<4>::new();
+        scene
+            .push(Obstacle::cuboid(center.into(), [0.01, 0.02, 0.02], hand.quaternion_wxyz()).unwrap())
+            .unwrap();
+        scene
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the exact checker: slow under Miri")]
+    fn a_plate_between_open_fingers_is_free_and_closed_fingers_touch_it() {
+        let scene = plate_between_the_fingers();
+        let config = CheckConfig::default();
+        for w in [0.04, 0.025, 0.015] {
+            let open = scene.clone().with_gripper(w).unwrap();
+            assert_eq!(check_state(&open, &READY, &config), Ok(None), "{w}");
+            assert!(clearance(&open, &READY).unwrap() > 0.0, "{w}");
+        }
+        let closed = scene.with_gripper(0.0).unwrap();
+        let contact = check_state(&closed, &READY, &config).unwrap();
+        let finger = |b: u8| crate::robot::BODY_NAMES[usize::from(b)].ends_with("finger");
+        assert!(
+            matches!(contact, Some(Contact::Obstacle { body, obstacle: 0 }) if finger(body)),
+            "{contact:?}"
+        );
+        assert_eq!(check_end(&closed, &READY, &config).unwrap(), contact);
+        assert_eq!(clearance(&closed, &READY), Ok(0.0));
+        // A trajectory that stays put collides at every state, the first at once.
+        let report = check_trajectory(&closed, &[READY; 3], &config, false).unwrap();
+        assert_eq!(report.colliding_states, report.states);
+    }
 
     #[test]
     fn ready_pose_in_an_empty_scene_is_free() {

@@ -19,7 +19,7 @@
 
 use crate::error::Error;
 use crate::geometry::{Aabb, BoxFrame, CylinderBox, Inflation, box_dims, inflated_dims, obstacle_aabb};
-use crate::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward};
+use crate::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward_with};
 use crate::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Obstacle, Scene};
 use nalgebra::{Matrix3, Vector3};
@@ -320,7 +320,8 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     let mut total = 0.0f32;
     let mut previous: Option<Waypoint> = None;
     for (w, q) in trajectory.iter().enumerate() {
-        let mut current = Waypoint::new(forward(q)?, held);
+        // The scene's finger opening places the finger boxes; for the adjoint it is a constant.
+        let mut current = Waypoint::new(forward_with(q, scene.gripper())?, held);
         match (config.kind, previous.as_mut()) {
             (CostKind::Intersection, _) if w > 0 && w + 1 < H => total += intersection(&mut current, obstacles),
             (CostKind::Swept, Some(before)) => total += swept(before, &mut current, obstacles),
@@ -477,6 +478,7 @@ fn waypoint_gradient(w: &Waypoint) -> Result<Joints<f32>, Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kinematics::forward;
     use crate::scene::Obstacle;
 
     const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
@@ -526,6 +528,30 @@ mod tests {
         // A stationary trajectory sweeps exactly its boxes: sv over 3 segments = iv over 2 interior waypoints × 3/2.
         let sv = trajectory_cost(&scene, &traj, &config(CostKind::Swept), None).unwrap();
         assert!((sv - iv * 1.5).abs() <= 1e-6 * sv, "{sv} vs {iv}");
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "costs and gradient of a whole trajectory: too slow")]
+    fn the_finger_boxes_follow_the_scenes_opening() {
+        // A plate between the fingers: the finger boxes overlap it only when closed.
+        let k = forward(&READY).unwrap();
+        let hand = &k.frames[HAND_FRAME];
+        let center = hand.transform_point(&Vector3::new(0.0, 0.0, 0.095));
+        let mut scene = Scene::<4>::new();
+        scene
+            .push(Obstacle::cuboid(center.into(), [0.01, 0.02, 0.02], hand.quaternion_wxyz()).unwrap())
+            .unwrap();
+        let traj = [READY; 4];
+        let open = scene.clone().with_gripper(0.04).unwrap();
+        let closed = scene.with_gripper(0.0).unwrap();
+        for kind in [CostKind::Intersection, CostKind::Swept] {
+            let mut g = [[1.0; 7]; 4];
+            assert_eq!(trajectory_cost(&open, &traj, &config(kind), Some(&mut g)), Ok(0.0));
+            assert!(g.iter().flatten().all(|&x| x == 0.0));
+            let cost = trajectory_cost(&closed, &traj, &config(kind), Some(&mut g)).unwrap();
+            assert!(cost > 0.0, "{kind:?}");
+            assert!(g.iter().flatten().any(|&x| x != 0.0), "{kind:?}");
+        }
     }
 
     #[test]

@@ -6,7 +6,9 @@
 //! so the answer is deterministic and the work is bounded (`starts × iterations` FK and 6×6
 //! solves at most). Each iterate is projected back into the limits; a converged solution is
 //! kept only if the exact checker finds it free in the scene (by default PyBullet's rule for
-//! valid ends, `checker::END_MARGIN`). Of the solutions found, the one
+//! valid ends, `checker::END_MARGIN`), the fingers at the scene's opening
+//! ([`Scene::gripper`]; the TCP itself does not depend on it, so the descent runs at the default
+//! opening). Of the solutions found, the one
 //! nearest the preferred configuration (Euclidean, joint space) wins.
 
 use crate::checker::{CheckConfig, END_MARGIN, check_end};

@@ -1,7 +1,10 @@
 //! Forward kinematics of the Panda, its hand-written adjoint, and frame Jacobians.
 //!
 //! [`forward`] maps 7 joint angles to the world pose of every link frame and of every
-//! collision box. [`Kinematics::adjoint`] takes an upstream gradient on box corners back to the
+//! collision box, the fingers at the default opening; [`forward_with`] takes the opening (the
+//! scene's `gripper.finger`, [`crate::scene::Scene::gripper`]) too. The opening moves the
+//! finger frames along their prismatic axes (the hand's ±y) and nothing else: for the adjoint
+//! and the Jacobians it is a constant. [`Kinematics::adjoint`] takes an upstream gradient on box corners back to the
 //! joints; [`Cotangent`] gathers any other (on points moving with a frame, on frame poses) for
 //! [`Kinematics::joint_gradient`]. Both end in one leaf-to-root sweep:
 //!
@@ -146,17 +149,31 @@ pub fn box_corner<T: Real>(pose: &Pose<T>, half: &Vector3<T>, k: usize) -> Vecto
     pose.transform_point(&Vector3::new(s(0, half.x), s(1, half.y), s(2, half.z)))
 }
 
-/// Forward kinematics: world pose of every frame and collision box.
+/// Forward kinematics: world pose of every frame and collision box, each finger at the
+/// default opening (`robot::FINGER_OPENING_DEFAULT`, 0.025 m). See [`forward_with`].
 ///
 /// Any finite angle is accepted (limits are the planner's business); NaN or infinity is
 /// refused with [`Error::NonFiniteJoint`], so every output is finite.
 pub fn forward<T: Real>(q: &Joints<T>) -> Result<Kinematics<T>, Error> {
+    forward_with(q, T::robot().finger_default)
+}
+
+/// Forward kinematics with each finger opened to `finger` metres (the value of both finger
+/// joints; the fingers' frames slide by it along their prismatic axes). With the default
+/// opening the result is [`forward`]'s, bit for bit.
+///
+/// Joints as in [`forward`] (checked first); an opening outside the URDF's finger limits
+/// (`robot::FINGER_OPENING_MIN..=FINGER_OPENING_MAX`), or NaN, is [`Error::BadParameter`].
+pub fn forward_with<T: Real>(q: &Joints<T>, finger: T) -> Result<Kinematics<T>, Error> {
     for (i, &qi) in q.iter().enumerate() {
         if !qi.finite() {
             return Err(Error::NonFiniteJoint { joint: i as u8 });
         }
     }
     let robot = T::robot();
+    if !(finger >= robot.finger_lower && finger <= robot.finger_upper) {
+        return Err(Error::BadParameter);
+    }
     let mut frames = [Pose::identity(); FRAMES];
     for i in 1..FRAMES {
         let spec = &robot.frames[i];
@@ -167,8 +184,12 @@ pub fn forward<T: Real>(q: &Joints<T>) -> Result<Kinematics<T>, Error> {
             }
             None => spec.rot_fixed,
         };
+        let translation = match &spec.slide {
+            Some(slide) => spec.translation + slide * finger,
+            None => spec.translation,
+        };
         let parent = frames[spec.parent.min(i - 1)];
-        frames[i] = parent.compose(&rotation, &spec.translation);
+        frames[i] = parent.compose(&rotation, &translation);
     }
     let mut boxes = [Pose::identity(); BODIES];
     for (pose, body) in boxes.iter_mut().zip(robot.bodies.iter()) {
@@ -322,6 +343,54 @@ mod tests {
         assert!((p.x - 0.088).abs() < 1e-9, "{p}");
         assert!(p.y.abs() < 1e-9, "{p}");
         assert!((p.z - (0.333 + 0.316 + 0.384 - 0.107 - 0.105)).abs() < 1e-9, "{p}");
+    }
+
+    #[test]
+    fn the_fingers_slide_by_the_opening_along_the_hands_y() {
+        use crate::robot::{FINGER_OPENING_DEFAULT, HAND_FRAME};
+        let (left, right) = (10, 11);
+        let base = forward(&READY).unwrap();
+        // The default opening is `forward`'s, bit for bit.
+        assert_eq!(forward_with(&READY, FINGER_OPENING_DEFAULT).unwrap(), base);
+        let q64 = READY.map(f64::from);
+        for w in [0.0, 0.01, 0.025, 0.04] {
+            let k = forward_with(&q64, w).unwrap();
+            let hand = &k.frames[HAND_FRAME];
+            let y = hand.rotation.column(1).into_owned();
+            // In the hand frame: each finger sits at (0, ±w, 0.0584), the URDF's origin.
+            let l = hand.rotation.transpose() * (k.frames[left].translation - hand.translation);
+            let r = hand.rotation.transpose() * (k.frames[right].translation - hand.translation);
+            assert!((l - Vector3::new(0.0, w, 0.0584)).norm() < 1e-12, "{w}: {l}");
+            assert!((r - Vector3::new(0.0, -w, 0.0584)).norm() < 1e-12, "{w}: {r}");
+            // The fingers are 2w apart along the hand's y, their orientation the hand's.
+            let gap = k.frames[left].translation - k.frames[right].translation;
+            assert!((gap - y * (2.0 * w)).norm() < 1e-12, "{w}: {gap}");
+            assert!((k.frames[left].rotation - hand.rotation).norm() < 1e-12);
+            // Nothing else moves: every other frame and box is the default's.
+            let d = forward(&q64).unwrap();
+            for f in (0..FRAMES).filter(|&f| f != left && f != right) {
+                assert_eq!(k.frames[f], d.frames[f], "frame {f}");
+            }
+            for b in 0..BODIES - 2 {
+                assert_eq!(k.boxes[b], d.boxes[b], "box {b}");
+            }
+            // The finger boxes move rigidly with their frames.
+            let shift = (w - 0.025) * y;
+            assert!((k.boxes[BODIES - 2].translation - d.boxes[BODIES - 2].translation - shift).norm() < 1e-12);
+            assert!((k.boxes[BODIES - 1].translation - d.boxes[BODIES - 1].translation + shift).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn refuses_openings_outside_the_finger_limits() {
+        for w in [f32::NAN, -1e-6, 0.0401, f32::INFINITY, -f32::INFINITY] {
+            assert_eq!(forward_with(&READY, w), Err(Error::BadParameter), "{w}");
+        }
+        assert!(forward_with(&READY, 0.0).is_ok() && forward_with(&READY, 0.04).is_ok());
+        // A bad joint is named first.
+        let mut q = READY;
+        q[2] = f32::NAN;
+        assert_eq!(forward_with(&q, f32::NAN), Err(Error::NonFiniteJoint { joint: 2 }));
     }
 
     #[test]

@@ -1,4 +1,7 @@
 //! The Panda as frozen by `edmp-codegen` at build time: link frames, collision boxes, limits.
+//! The one input the tables leave open is the gripper opening: each finger frame is its fixed
+//! transform at opening 0 plus [`FrameSpec::slide`] times the opening (see
+//! [`crate::kinematics::forward_with`]).
 //!
 //! No number of the robot is typed here: the tables come from `OUT_DIR/panda.rs`, which the
 //! build script generates from `weights/panda/panda.urdf` and its collision meshes. Read the
@@ -13,9 +16,10 @@ pub struct FrameSpec<T> {
     pub parent: usize,
     /// The actuated joint that turns this frame, if any.
     pub joint: Option<usize>,
-    /// Joint origin translation in the parent frame.
+    /// Joint origin translation in the parent frame (for a finger: at opening 0).
     pub translation: Vector3<T>,
-    /// Unit joint axis in this frame (zero for fixed frames).
+    /// Unit joint axis in this frame: revolute, or a finger's prismatic axis (zero for fixed
+    /// frames).
     pub axis: Vector3<T>,
     /// With `rot_cos` and `rot_sin`: the rotation relative to the parent is
     /// `rot_fixed + cos(q)·rot_cos + sin(q)·rot_sin` (Rodrigues folded with the origin rotation).
@@ -24,6 +28,10 @@ pub struct FrameSpec<T> {
     pub rot_cos: Matrix3<T>,
     /// See `rot_fixed`.
     pub rot_sin: Matrix3<T>,
+    /// For a finger: its displacement in the parent frame per metre of gripper opening (the
+    /// prismatic axis turned into the parent frame; a `<mimic>` joint's multiplier folded in).
+    /// The frame's translation is `translation + slide · w`. `None` for every other frame.
+    pub slide: Option<Vector3<T>>,
 }
 
 /// A collision body's oriented box in its link frame.
@@ -60,6 +68,12 @@ pub struct Robot<T> {
     pub hard_lower: [T; JOINTS],
     /// URDF `<limit upper>`.
     pub hard_upper: [T; JOINTS],
+    /// The finger opening an absent `gripper` field means (`spec/formats.md`): 0.025 m.
+    pub finger_default: T,
+    /// Smallest finger opening (the driving finger joint's `<limit lower>`).
+    pub finger_lower: T,
+    /// Largest finger opening (its `<limit upper>`).
+    pub finger_upper: T,
 }
 
 include!(concat!(env!("OUT_DIR"), "/panda.rs"));
@@ -176,6 +190,30 @@ mod tests {
             }
         }
         assert_eq!(FRAME_NAMES[TCP_FRAME], "panda_grasptarget");
+        // The fingers, and only they, slide with the opening; both open along the hand's y.
+        let sliding: [usize; 2] = [10, 11];
+        for (i, (f, name)) in PANDA_F64.frames.iter().zip(FRAME_NAMES).enumerate() {
+            assert_eq!(f.slide.is_some(), sliding.contains(&i), "{name}");
+        }
+        assert_eq!(FRAME_NAMES[10], "panda_leftfinger");
+        assert_eq!(PANDA_F64.frames[10].slide, Some(Vector3::new(0.0, 1.0, 0.0)));
+        assert_eq!(PANDA_F64.frames[11].slide, Some(Vector3::new(0.0, -1.0, 0.0)));
+        assert_eq!(PANDA_F64.frames[10].parent, HAND_FRAME);
+        // At the default opening the fingers sit exactly where the tables with 0.025 m folded
+        // into the translation (before the opening was an input) put them, in f32 bits.
+        for (f, y) in [(10, 0.025f32), (11, -0.025)] {
+            let spec = &PANDA.frames[f];
+            let at_default = spec.translation + spec.slide.unwrap() * PANDA.finger_default;
+            assert_eq!(at_default, Vector3::new(0.0f32, y, 0.0584), "frame {f}");
+        }
+        assert_eq!(
+            (PANDA.finger_default, PANDA.finger_lower, PANDA.finger_upper),
+            (FINGER_OPENING_DEFAULT, FINGER_OPENING_MIN, FINGER_OPENING_MAX)
+        );
+        assert_eq!(
+            (FINGER_OPENING_MIN, FINGER_OPENING_DEFAULT, FINGER_OPENING_MAX),
+            (0.0, 0.025, 0.04)
+        );
         assert_eq!(FRAME_NAMES[HAND_FRAME], "panda_hand");
         assert!(PANDA.is_ancestor(1, TCP_FRAME) && !PANDA.is_ancestor(10, TCP_FRAME));
     }

@@ -1,7 +1,9 @@
-//! The planning scene: obstacles (cuboids, cylinders, spheres) in a fixed-capacity list, and an
-//! optional object held in the hand. Everything is validated on the way in, so the costs and
+//! The planning scene: obstacles (cuboids, cylinders, spheres) in a fixed-capacity list, an
+//! optional object held in the hand, and the gripper's opening (`gripper.finger`, both fingers
+//! at it for the whole plan: the costs, the checker and IK's check all read it). Everything is validated on the way in, so the costs and
 //! the checker never see a NaN, a zero size or a non-rotation.
 
+use crate::robot::{FINGER_OPENING_DEFAULT, FINGER_OPENING_MAX, FINGER_OPENING_MIN};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// Default obstacle capacity of a [`Scene`].
@@ -55,6 +57,9 @@ pub enum SceneError {
     NonPositiveSize,
     /// The scene already holds its capacity of obstacles.
     TooManyObstacles,
+    /// The finger opening is outside the URDF's finger limits, 0 to 0.04 m
+    /// (`robot::FINGER_OPENING_MIN`, `robot::FINGER_OPENING_MAX`).
+    FingerOutOfRange,
 }
 
 impl core::fmt::Display for SceneError {
@@ -64,6 +69,7 @@ impl core::fmt::Display for SceneError {
             Self::QuaternionNorm => "quaternion norm is not within 1e-3 of 1",
             Self::NonPositiveSize => "size must be positive",
             Self::TooManyObstacles => "too many obstacles for the scene's capacity",
+            Self::FingerOutOfRange => "finger opening outside [0, 0.04] m",
         })
     }
 }
@@ -135,21 +141,59 @@ impl Obstacle {
     }
 }
 
-/// Obstacles (at most `N`) and an optional object held in the hand (pose in the
-/// `panda_hand` frame).
-#[derive(Clone, Debug, Default)]
+/// Obstacles (at most `N`), an optional object held in the hand (pose in the `panda_hand`
+/// frame) and the opening of each finger (default `robot::FINGER_OPENING_DEFAULT`, 0.025 m).
+#[derive(Clone, Debug)]
 pub struct Scene<const N: usize = MAX_OBSTACLES> {
     obstacles: heapless::Vec<Obstacle, N>,
     held: Option<Obstacle>,
+    finger: f32,
+}
+
+impl<const N: usize> Default for Scene<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// A finger opening, validated: finite and within the URDF's finger limits.
+pub fn finger_opening(finger: f32) -> Result<f32, SceneError> {
+    finite(&[finger])?;
+    if (FINGER_OPENING_MIN..=FINGER_OPENING_MAX).contains(&finger) {
+        Ok(finger)
+    } else {
+        Err(SceneError::FingerOutOfRange)
+    }
 }
 
 impl<const N: usize> Scene<N> {
-    /// An empty scene.
+    /// An empty scene, the fingers at the default opening.
     pub const fn new() -> Self {
         Self {
             obstacles: heapless::Vec::new(),
             held: None,
+            finger: FINGER_OPENING_DEFAULT,
         }
+    }
+
+    /// This scene with each finger opened to `finger` metres (the scene file's
+    /// `gripper.finger`): NaN or infinity is [`SceneError::NonFinite`], outside 0..=0.04 m
+    /// [`SceneError::FingerOutOfRange`].
+    pub fn with_gripper(mut self, finger: f32) -> Result<Self, SceneError> {
+        self.set_gripper(finger)?;
+        Ok(self)
+    }
+
+    /// Sets the opening of each finger (see [`Self::with_gripper`]); on error the scene keeps
+    /// its opening.
+    pub fn set_gripper(&mut self, finger: f32) -> Result<(), SceneError> {
+        self.finger = finger_opening(finger)?;
+        Ok(())
+    }
+
+    /// The opening of each finger, metres (validated: within 0..=0.04).
+    pub fn gripper(&self) -> f32 {
+        self.finger
     }
 
     /// Adds an obstacle (already validated by its constructor).
@@ -210,6 +254,31 @@ mod tests {
         let o = Obstacle::cuboid([0.0; 3], [1.0; 3], [h, 0.0, 0.0, h]).unwrap();
         let x = o.rotation * Vector3::x();
         assert!((x - Vector3::y()).norm() < 1e-6);
+    }
+
+    #[test]
+    fn the_gripper_opening_is_validated() {
+        let s = Scene::<2>::new();
+        assert_eq!(s.gripper(), 0.025);
+        assert_eq!(Scene::<2>::default().gripper(), 0.025);
+        assert_eq!(s.clone().with_gripper(0.04).map(|s| s.gripper()), Ok(0.04));
+        assert_eq!(s.clone().with_gripper(0.0).map(|s| s.gripper()), Ok(0.0));
+        assert_eq!(s.clone().with_gripper(f32::NAN).unwrap_err(), SceneError::NonFinite);
+        assert_eq!(
+            s.clone().with_gripper(f32::INFINITY).unwrap_err(),
+            SceneError::NonFinite
+        );
+        assert_eq!(
+            s.clone().with_gripper(-0.001).unwrap_err(),
+            SceneError::FingerOutOfRange
+        );
+        assert_eq!(
+            s.clone().with_gripper(0.0401).unwrap_err(),
+            SceneError::FingerOutOfRange
+        );
+        let mut t = s.with_gripper(0.01).unwrap();
+        assert_eq!(t.set_gripper(0.05), Err(SceneError::FingerOutOfRange));
+        assert_eq!(t.gripper(), 0.01);
     }
 
     #[test]

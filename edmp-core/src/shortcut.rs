@@ -239,7 +239,16 @@ mod tests {
         let check = CheckConfig::default();
         let mut path = detour();
         assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
-        let report = shorten(&scene, &START, &GOAL, &check, &ShortcutConfig::DEFAULT, &mut Rng::new(1), &mut path).unwrap();
+        let report = shorten(
+            &scene,
+            &START,
+            &GOAL,
+            &check,
+            &ShortcutConfig::DEFAULT,
+            &mut Rng::new(1),
+            &mut path,
+        )
+        .unwrap();
         assert!(report.length_after < 0.8 * report.length_before, "{report:?}");
         assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
         assert_eq!(path[0], START);
@@ -261,8 +270,20 @@ mod tests {
         });
         assert!(!check_trajectory(&scene, &straight, &check, true).unwrap().is_free());
         let mut path = detour();
-        assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free(), "the detour passes the wall");
-        shorten(&scene, &START, &GOAL, &check, &ShortcutConfig::DEFAULT, &mut Rng::new(2), &mut path).unwrap();
+        assert!(
+            check_trajectory(&scene, &path, &check, true).unwrap().is_free(),
+            "the detour passes the wall"
+        );
+        shorten(
+            &scene,
+            &START,
+            &GOAL,
+            &check,
+            &ShortcutConfig::DEFAULT,
+            &mut Rng::new(2),
+            &mut path,
+        )
+        .unwrap();
         assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
     }
 
@@ -272,7 +293,16 @@ mod tests {
         let check = CheckConfig::default();
         let run = |seed| {
             let mut path = detour();
-            shorten(&scene, &START, &GOAL, &check, &ShortcutConfig::DEFAULT, &mut Rng::new(seed), &mut path).unwrap();
+            shorten(
+                &scene,
+                &START,
+                &GOAL,
+                &check,
+                &ShortcutConfig::DEFAULT,
+                &mut Rng::new(seed),
+                &mut path,
+            )
+            .unwrap();
             path
         };
         assert_eq!(run(7), run(7));

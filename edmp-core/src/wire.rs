@@ -1,7 +1,7 @@
 //! A planning problem as plain numbers, for the wire (postcard) into firmware.
 //!
 //! [`Scene`] holds validated obstacles (rotation matrices); the wire carries what a scene file
-//! says instead: each primitive's parameters and quaternion, the start, a joint goal (a pose
+//! says instead: each primitive's parameters and quaternion, the finger opening, the start, a joint goal (a pose
 //! goal is resolved on the host: the firmware runs no IK) and the seed. [`Problem::to_scene`]
 //! rebuilds the scene through the same [`Obstacle`] constructors the host uses, so both sides
 //! plan on the same bits. Only with the `serde` feature.
@@ -62,13 +62,17 @@ impl Primitive {
     }
 }
 
-/// One planning problem: obstacles (at most `N`), the held object, the ends and the seed.
+/// One planning problem: obstacles (at most `N`), the held object, the finger opening, the
+/// ends and the seed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Problem<const N: usize = MAX_OBSTACLES> {
     /// The obstacles, in the scene file's order (the checker reports contacts by index).
     pub obstacles: heapless::Vec<Primitive, N>,
     /// An object held in the hand (pose in the `panda_hand` frame), if any.
     pub held: Option<Primitive>,
+    /// Opening of each finger, metres (the scene file's `gripper.finger`; 0.025 when absent),
+    /// validated by [`Scene::set_gripper`].
+    pub finger: f32,
     /// Start configuration.
     pub start: Joints<f32>,
     /// Goal configuration.
@@ -87,6 +91,7 @@ impl<const N: usize> Problem<N> {
         if let Some(held) = &self.held {
             scene.hold(held.to_obstacle()?);
         }
+        scene.set_gripper(self.finger)?;
         Ok(scene)
     }
 }
@@ -121,6 +126,7 @@ mod tests {
         Problem {
             obstacles,
             held: None,
+            finger: 0.025,
             start: [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785],
             goal: [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785],
             seed: 7,
@@ -137,6 +143,7 @@ mod tests {
             Obstacle::cylinder([0.45, 0.45, 0.1], 0.05, 0.2, ID).unwrap()
         );
         assert!(scene.held().is_none());
+        assert_eq!(scene.gripper(), 0.025);
     }
 
     #[test]
@@ -154,6 +161,21 @@ mod tests {
             quaternion: [0.5, 0.0, 0.0, 0.0],
         };
         assert_eq!(p.to_scene().unwrap_err(), SceneError::QuaternionNorm);
+    }
+
+    #[test]
+    fn carries_the_finger_opening() {
+        let mut p = problem();
+        p.finger = 0.04;
+        assert_eq!(p.to_scene().unwrap().gripper(), 0.04);
+        for (bad, e) in [
+            (0.041, SceneError::FingerOutOfRange),
+            (-0.01, SceneError::FingerOutOfRange),
+            (f32::NAN, SceneError::NonFinite),
+        ] {
+            p.finger = bad;
+            assert_eq!(p.to_scene().unwrap_err(), e, "{bad}");
+        }
     }
 
     #[test]

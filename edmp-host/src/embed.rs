@@ -5,6 +5,8 @@
 //! `tabletop-000`) and `DIR/expected.txt`, one line `<name> <status> <fingerprint>` per scene in
 //! the order given. The host plans the scene it rebuilt from the wire bytes, with the firmware's
 //! settings: [`PlanConfig::DEFAULT`], EDMP's 12 guides, 12 rows, `Rng::new(seed)`.
+//! `DIR/expected-timed.txt` has `<name> <fingerprint|none>`: the chosen path's time
+//! parameterization (Franka's limits, jerk-limited) for free plans, as the firmware times it.
 
 use crate::Failure;
 use crate::json::{joint_goal, parse_problem};
@@ -14,6 +16,7 @@ use edmp_core::planner::{Plan, PlanConfig, Workspace, plan};
 use edmp_core::prior::Scratch;
 use edmp_core::rng::Rng;
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
+use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
 use edmp_core::wire::{Primitive, Problem};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -96,6 +99,7 @@ pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, Str
     let mut problem = Problem {
         obstacles: Default::default(),
         held: None,
+        finger: parsed.scene.gripper(),
         start: parsed.start,
         goal,
         seed,
@@ -111,7 +115,10 @@ pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, Str
     }
     // The firmware rebuilds the scene from these numbers: it must be the host's scene exactly.
     let rebuilt = problem.to_scene().map_err(|e| e.to_string())?;
-    if rebuilt.obstacles() != parsed.scene.obstacles() || rebuilt.held() != parsed.scene.held() {
+    if rebuilt.obstacles() != parsed.scene.obstacles()
+        || rebuilt.held() != parsed.scene.held()
+        || rebuilt.gripper() != parsed.scene.gripper()
+    {
         return Err("the wire scene differs from the parsed one".to_owned());
     }
     Ok(problem)
@@ -141,6 +148,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let input = |e: String| Failure::Input(e);
     std::fs::create_dir_all(&args.out).map_err(|e| input(format!("{}: {e}", args.out.display())))?;
     let mut expected = String::new();
+    let mut expected_timed = String::new();
     for path in &args.scenes {
         let at = |e: String| Failure::Input(format!("{}: {e}", path.display()));
         let name = scene_name(path).map_err(input)?;
@@ -154,9 +162,31 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         let line = format!("{name} {status} {:016x}", plan.fingerprint());
         println!("{line}  ({} bytes)", bytes.len());
         let _ = writeln!(expected, "{line}");
+        let timed = time_like_firmware(&problem, &plan).map_err(at)?;
+        let _ = writeln!(
+            expected_timed,
+            "{name} {}",
+            timed.map_or("none".to_owned(), |f| format!("{f:016x}"))
+        );
     }
-    let file = args.out.join("expected.txt");
-    std::fs::write(&file, expected).map_err(|e| input(format!("{}: {e}", file.display())))
+    for (name, text) in [("expected.txt", expected), ("expected-timed.txt", expected_timed)] {
+        let file = args.out.join(name);
+        std::fs::write(&file, text).map_err(|e| input(format!("{}: {e}", file.display())))?;
+    }
+    Ok(())
+}
+
+/// The firmware's time parameterization of a free plan's chosen path, on the host: its
+/// fingerprint, `None` for a colliding plan (the firmware times only free ones).
+pub fn time_like_firmware(problem: &Problem<MAX_OBSTACLES>, plan: &Plan<ROWS>) -> Result<Option<u64>, String> {
+    let Some(path) = plan.paths.get(plan.best).filter(|_| plan.is_free()) else {
+        return Ok(None);
+    };
+    let scene: Scene<MAX_OBSTACLES> = problem.to_scene().map_err(|e| e.to_string())?;
+    let mut timed: Box<Timed> = Box::new(Timed::new());
+    parameterize_checked(&scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, &mut timed)
+        .map_err(|e| format!("time parameterization: {e}"))?;
+    Ok(Some(timed.fingerprint()))
 }
 
 #[cfg(test)]

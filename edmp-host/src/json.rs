@@ -4,7 +4,7 @@
 use edmp_core::checker::{CheckConfig, Contact, check_end};
 use edmp_core::ik::{IkConfig, solve};
 use edmp_core::kinematics::{Joints, Pose};
-use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS, PANDA};
+use edmp_core::robot::{BODY_NAMES, FINGER_OPENING_MAX, FINGER_OPENING_MIN, JOINT_NAMES, JOINTS, PANDA};
 use edmp_core::scene::{MAX_OBSTACLES, Obstacle, QUATERNION_NORM_TOLERANCE, Scene, SceneError, rotation_from_wxyz};
 use serde_json::{Map, Value};
 use std::fmt;
@@ -52,7 +52,7 @@ pub enum Goal {
 /// A parsed, validated problem.
 #[derive(Clone, Debug)]
 pub struct Problem {
-    /// The obstacles (and the held object).
+    /// The obstacles, the held object and the finger opening (`gripper.finger`).
     pub scene: Scene<MAX_OBSTACLES>,
     /// The start configuration.
     pub start: Joints<f32>,
@@ -225,7 +225,7 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
     let map = object(
         &root,
         "",
-        &["format", "obstacles", "start", "goal", "held_object", "meta"],
+        &["format", "obstacles", "start", "goal", "held_object", "gripper", "meta"],
     )?;
     if let Some(meta) = map.get("meta") {
         meta.as_object()
@@ -255,6 +255,19 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
     }
     if let Some(held) = map.get("held_object") {
         scene.hold(primitive(held, "held_object")?);
+    }
+    // Before the ends are checked: the fingers sit at this opening for the whole problem.
+    if let Some(gripper) = map.get("gripper") {
+        let gm = object(gripper, "gripper", &["finger"])?;
+        let (f, fp) = field(gm, "gripper", "finger")?;
+        let finger = number(f, &fp)?;
+        scene.set_gripper(finger).map_err(|e| match e {
+            SceneError::FingerOutOfRange => InputError::at(
+                &fp,
+                format!("{finger} outside [{FINGER_OPENING_MIN}, {FINGER_OPENING_MAX}]"),
+            ),
+            other => InputError::at(&fp, other.to_string()),
+        })?;
     }
     let (start, sp) = field(map, "", "start")?;
     let start = joints(start, &sp)?;
@@ -349,5 +362,65 @@ mod tests {
             error_of(&collide)
         );
         assert!(error_of("{").starts_with("not valid JSON"));
+    }
+
+    fn with_gripper(gripper: &str) -> String {
+        GOOD.replacen("\"format\"", &format!("\"gripper\": {gripper}, \"format\""), 1)
+    }
+
+    #[test]
+    fn the_gripper_field_sets_the_finger_opening() {
+        assert_eq!(parse_problem(GOOD).unwrap().scene.gripper(), 0.025);
+        for (text, w) in [("0.04", 0.04), ("0", 0.0), ("0.0125", 0.0125)] {
+            let p = parse_problem(&with_gripper(&format!(r#"{{"finger": {text}}}"#))).unwrap();
+            assert_eq!(p.scene.gripper(), w);
+        }
+        let cases = [
+            (r#"{"finger": 0.05}"#, "gripper.finger: 0.05 outside [0, 0.04]"),
+            (r#"{"finger": -0.001}"#, "gripper.finger: -0.001 outside [0, 0.04]"),
+            (
+                r#"{"finger": "wide"}"#,
+                "gripper.finger: expected a number, found \"wide\"",
+            ),
+            (r#"{}"#, "gripper.finger: missing"),
+            (r#"0.04"#, "gripper: expected an object"),
+        ];
+        for (gripper, message) in cases {
+            assert_eq!(error_of(&with_gripper(gripper)), message, "{gripper}");
+        }
+        let huge = error_of(&with_gripper(r#"{"finger": 1e300}"#));
+        assert!(
+            huge.starts_with("gripper.finger: 1") && huge.ends_with("is not a finite f32"),
+            "{huge}"
+        );
+        let typo = error_of(&with_gripper(r#"{"finger": 0.04, "fingers": 0.04}"#));
+        assert!(
+            typo.starts_with("gripper.fingers: unknown field (expected one of: finger)"),
+            "{typo}"
+        );
+    }
+
+    #[test]
+    fn the_ends_are_checked_at_the_scenes_opening() {
+        // A plate between the fingers at the start: free with the fingers open, in contact closed.
+        let ready = [0.0f32, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
+        let k = edmp_core::kinematics::forward(&ready).unwrap();
+        let hand = &k.frames[edmp_core::robot::HAND_FRAME];
+        let c = hand.transform_point(&nalgebra::Vector3::new(0.0, 0.0, 0.095));
+        let q = hand.quaternion_wxyz();
+        let doc = |finger: f32| {
+            serde_json::json!({
+                "format": "edmp-scene/1",
+                "obstacles": [{"type": "cuboid", "center": [c.x, c.y, c.z], "dims": [0.01, 0.02, 0.02], "quaternion": q}],
+                "start": ready,
+                "goal": {"joints": [0.3, -0.5, 0.1, -2.0, 0.0, 1.6, 0.9]},
+                "gripper": {"finger": finger},
+            })
+            .to_string()
+        };
+        assert!(parse_problem(&doc(0.04)).is_ok());
+        let closed = parse_problem(&doc(0.0)).unwrap_err().to_string();
+        assert!(closed.starts_with("start: in collision: panda_"), "{closed}");
+        assert!(closed.contains("finger touches obstacles[0]"), "{closed}");
     }
 }

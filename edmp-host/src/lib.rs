@@ -11,6 +11,7 @@ pub mod fk;
 pub mod gen_data;
 pub mod json;
 mod metrics;
+pub mod moveit;
 pub mod plan_cmd;
 mod plots;
 pub mod render;

@@ -3,7 +3,7 @@
 
 use clap::{Parser, Subcommand};
 use edmp_host::{
-    Failure, bench, bench_report, bench_rrt, embed, fk, gen_data, plan_cmd, render, rrt_cmd, sample, suite,
+    Failure, bench, bench_report, bench_rrt, embed, fk, gen_data, moveit, plan_cmd, render, rrt_cmd, sample, suite,
 };
 use std::process::ExitCode;
 
@@ -39,6 +39,8 @@ enum Command {
     Sample(sample::Args),
     /// Scenes as postcard bytes for the QEMU firmware, with the host's plan of each.
     Embed(embed::Args),
+    /// Convert a MoveIt planning scene (and motion plan request) YAML to `edmp-scene/1` JSON.
+    ImportMoveit(moveit::Args),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +57,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(&args).map_err(Failure::Input),
         Command::Sample(args) => sample::run(&args).map_err(Failure::Input),
         Command::Embed(args) => embed::run(&args),
+        Command::ImportMoveit(args) => moveit::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

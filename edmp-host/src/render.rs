@@ -8,7 +8,7 @@
 
 use crate::json::{Goal, parse_problem};
 use edmp_core::convex::{Convex, Primitive};
-use edmp_core::kinematics::{Joints, forward};
+use edmp_core::kinematics::{Joints, forward, forward_with};
 use edmp_core::robot::{BODIES, PANDA};
 use edmp_core::scene::Shape;
 use nalgebra::Vector3;
@@ -257,8 +257,8 @@ fn waypoints(value: &serde_json::Value, at: &str) -> Result<Vec<Joints<f32>>, St
         .collect()
 }
 
-fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, color: [f32; 3], alpha: f32) -> Result<(), String> {
-    let k = forward(q).map_err(|e| e.to_string())?;
+fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, finger: f32, color: [f32; 3], alpha: f32) -> Result<(), String> {
+    let k = forward_with(q, finger).map_err(|e| e.to_string())?;
     for b in 0..BODIES {
         let pose = &k.frames[PANDA.bodies[b].frame];
         let pts: Vec<_> = PANDA.hull(b).iter().map(|p| pose.transform_point(p)).collect();
@@ -307,6 +307,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     for o in problem.scene.obstacles() {
         draw(&mut canvas, &outline(&Primitive::obstacle(o)), [0.35, 0.35, 0.38], 0.45);
     }
+    let finger = problem.scene.gripper();
     let path = match (&plan, &args.plan) {
         (Some(plan), Some(file)) => Some(waypoints(plan, &file.display().to_string())?),
         _ => None,
@@ -314,12 +315,18 @@ pub fn run(args: &Args) -> Result<(), String> {
     if let Some(path) = &path {
         let n = path.len().max(1);
         for (i, q) in path.iter().enumerate().step_by(4) {
-            draw_robot(&mut canvas, q, [0.95, 0.55, 0.1], 0.08 + 0.2 * i as f32 / n as f32)?;
+            draw_robot(
+                &mut canvas,
+                q,
+                finger,
+                [0.95, 0.55, 0.1],
+                0.08 + 0.2 * i as f32 / n as f32,
+            )?;
         }
     }
-    draw_robot(&mut canvas, &problem.start, [0.15, 0.35, 0.85], 0.35)?;
+    draw_robot(&mut canvas, &problem.start, finger, [0.15, 0.35, 0.85], 0.35)?;
     if let Goal::Joints(goal) = problem.goal {
-        draw_robot(&mut canvas, &goal, [0.1, 0.65, 0.25], 0.35)?;
+        draw_robot(&mut canvas, &goal, finger, [0.1, 0.65, 0.25], 0.35)?;
     }
     if args.candidates {
         let list = plan

@@ -54,7 +54,9 @@ impl TimedRequest {
         }
         let scale_ok = |s: f32| s > 0.0 && s <= 1.0;
         if !scale_ok(velocity_scale) {
-            return Err(Failure::Input(format!("--velocity-scale: {velocity_scale} outside (0, 1]")));
+            return Err(Failure::Input(format!(
+                "--velocity-scale: {velocity_scale} outside (0, 1]"
+            )));
         }
         if !scale_ok(acceleration_scale) {
             return Err(Failure::Input(format!(
@@ -99,7 +101,11 @@ pub fn trajectory_document<const N: usize>(
     let n = (duration * request.rate).ceil() as usize;
     let points: Vec<Value> = (0..=n)
         .map(|k| {
-            let time = if k == n { timed.duration() } else { (k as f64 / request.rate) as f32 };
+            let time = if k == n {
+                timed.duration()
+            } else {
+                (k as f64 / request.rate) as f32
+            };
             let p = timed.sample(time);
             json!({
                 "positions": p.positions,

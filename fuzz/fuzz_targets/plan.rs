@@ -9,10 +9,11 @@ use edmp_core::geometry::{BoxFrame, CylinderBox};
 use edmp_core::guides::EDMP_GUIDES;
 use edmp_core::global::GlobalConfig;
 use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
-use edmp_core::search::SearchConfig;
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
+use edmp_core::search::SearchConfig;
+use edmp_core::shortcut::ShortcutConfig;
 use libfuzzer_sys::fuzz_target;
 
 struct Reader<'a>(&'a [u8]);
@@ -82,6 +83,16 @@ fuzz_target!(|data: &[u8]| {
                 steps: u16::from(r.byte() % 4),
                 per_step: r.byte() % 3,
                 refine: r.byte() % 3,
+            })
+        },
+        // Shortening of a free winner, with a fuzzed budget.
+        shortcut: if r.byte() & 1 == 0 {
+            None
+        } else {
+            Some(ShortcutConfig {
+                greedy_checks: u32::from(r.byte() % 80),
+                attempts: u32::from(r.byte() % 16),
+                smoothing: r.byte() % 4,
             })
         },
     };

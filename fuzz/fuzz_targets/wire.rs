@@ -1,8 +1,8 @@
 //! Arbitrary bytes through the firmware's decoder: `postcard::from_bytes::<wire::Problem<N>>`
 //! then `Problem::to_scene`, as examples/firmware-qemu decodes. Decoding must fail cleanly or
 //! give a problem that re-encodes to bytes that decode to the same problem; `to_scene` must
-//! build exactly the primitives' obstacles (finite, positive, rotations orthonormal) or return
-//! the first primitive's typed error, never `TooManyObstacles` (the list and the scene share N).
+//! build exactly the primitives' obstacles (finite, positive, rotations orthonormal) and the
+//! finger opening, or return the first primitive's typed error (then the opening's), never `TooManyObstacles` (the list and the scene share N).
 #![no_main]
 
 use edmp_core::scene::{SceneError, Shape};
@@ -26,12 +26,14 @@ fuzz_target!(|data: &[u8]| {
         .iter()
         .chain(problem.held.iter())
         .map(|p| p.to_obstacle())
-        .find_map(Result::err);
+        .find_map(Result::err)
+        .or_else(|| edmp_core::scene::finger_opening(problem.finger).err());
     match problem.to_scene() {
         Ok(scene) => {
             assert!(expected.is_none());
             assert_eq!(scene.obstacles().len(), problem.obstacles.len());
             assert_eq!(scene.held().is_some(), problem.held.is_some());
+            assert_eq!(scene.gripper().to_bits(), problem.finger.to_bits());
             for o in scene.obstacles().iter().chain(scene.held()) {
                 assert!(o.center.iter().chain(o.rotation.iter()).all(|x| x.is_finite()));
                 let r = o.rotation;

@@ -10,7 +10,7 @@
 
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
-use edmp_core::kinematics::forward;
+use edmp_core::kinematics::{forward, forward_with};
 use edmp_core::robot::{BODIES, JOINTS, PANDA};
 use edmp_core::scene::{Obstacle, Scene};
 use edmp_tests::reference;
@@ -49,9 +49,11 @@ fn case() -> impl Strategy<Value = Case> {
         prop::collection::vec(obstacle, 1..6),
         any::<bool>(),
         config,
+        // The finger opening: the default, or anywhere in the URDF's range (closed and wide open included).
+        prop_oneof![Just(0.025f32), Just(0.0f32), Just(0.04f32), 0.0f32..=0.04],
     )
         .prop_map(
-            move |(a, b, noise, obstacles, held, (kind, clearance, expansion, cyl, frame))| {
+            move |(a, b, noise, obstacles, held, (kind, clearance, expansion, cyl, frame), finger)| {
                 let lerp = |t: f32, j: usize| {
                     let r = joint(j);
                     let x = r.start + (a[j] + (b[j] - a[j]) * t) * (r.end - r.start);
@@ -61,9 +63,9 @@ fn case() -> impl Strategy<Value = Case> {
                     core::array::from_fn(|j| lerp(w as f32 / (H - 1) as f32, j) + noise[w][j])
                 });
                 // Obstacles sit on the robot: centred near a body corner at a waypoint.
-                let mut scene = Scene::<16>::new();
+                let mut scene = Scene::<16>::new().with_gripper(finger).unwrap();
                 for (i, (shape, body, corner, offset, size, quat)) in obstacles.into_iter().enumerate() {
-                    let k = forward(&trajectory[i % H]).unwrap();
+                    let k = forward_with(&trajectory[i % H], finger).unwrap();
                     let c = k.corners(body)[corner];
                     let center = [c.x + offset[0], c.y + offset[1], c.z + offset[2]];
                     let n = quat.iter().map(|v| v * v).sum::<f32>().sqrt().max(1e-3);
@@ -175,7 +177,7 @@ proptest! {
     #[test]
     fn far_obstacles_cost_exactly_zero(c in case(), dir in prop::array::uniform3(-1.0f32..1.0), far in 2.5f32..10.0) {
         let n = dir.iter().map(|x| x * x).sum::<f32>().sqrt().max(1e-3);
-        let mut scene = Scene::<16>::new();
+        let mut scene = Scene::<16>::new().with_gripper(c.scene.gripper()).unwrap();
         scene.push(Obstacle::sphere(dir.map(|x| x / n * far), 0.3).unwrap()).unwrap();
         if let Some(held) = c.scene.held() {
             scene.hold(*held);
@@ -194,6 +196,87 @@ proptest! {
         let a = edmp_core::geometry::Aabb { min, max };
         let d = max - min;
         prop_assert_eq!(a.intersection_volume(&a), d.x * d.y * d.z);
+    }
+}
+
+/// The opening is a constant for the adjoint: a thin plate between the fingers pulls on the
+/// closed fingers only, and the adjoint there matches central differences of the reference
+/// (which places the fingers independently, in f64).
+#[test]
+fn the_gradient_at_a_non_default_opening_matches_finite_differences() {
+    let q = [0.1f32, -0.6, 0.05, -2.2, 0.02, 1.7, 0.6];
+    let k = forward(&q).unwrap();
+    let hand = &k.frames[edmp_core::robot::HAND_FRAME];
+    let center = hand.transform_point(&nalgebra::Vector3::new(0.0, 0.0, 0.095));
+    let trajectory: [[f32; JOINTS]; H] = core::array::from_fn(|w| {
+        core::array::from_fn(|j| q[j] + 0.004 * (w as f32 - 2.5) * if j % 2 == 0 { 1.0 } else { -0.7 })
+    });
+    for (finger, pulls) in [(0.0f32, true), (0.005, true), (0.04, false)] {
+        let mut scene = Scene::<16>::new().with_gripper(finger).unwrap();
+        scene
+            .push(Obstacle::cuboid(center.into(), [0.012, 0.018, 0.03], hand.quaternion_wxyz()).unwrap())
+            .unwrap();
+        for kind in [CostKind::Intersection, CostKind::Swept] {
+            let config = CostConfig {
+                kind,
+                inflation: Inflation {
+                    clearance: 0.001,
+                    expansion: 0.0,
+                },
+                cylinder: CylinderBox::Enclosing,
+                frame: BoxFrame::Obstacle,
+            };
+            let mut grad = [[0.0f32; JOINTS]; H];
+            let cost = trajectory_cost(&scene, &trajectory, &config, Some(&mut grad)).unwrap();
+            let q64: Vec<[f64; JOINTS]> = trajectory.iter().map(|q| q.map(f64::from)).collect();
+            let here = reference::cost(&scene, &q64, &config);
+            assert!(
+                (f64::from(cost) - here.value).abs() <= 1e-4 * here.value + 1e-9,
+                "{cost} vs {}",
+                here.value
+            );
+            assert_eq!(cost > 0.0, pulls, "{finger} {kind:?}: {cost}");
+            if !pulls {
+                assert!(grad.iter().flatten().all(|&g| g == 0.0));
+                continue;
+            }
+            let h = 1e-6;
+            let mut kept = 0;
+            let mut scale = 0.0f64;
+            let mut fd = [[0.0f64; JOINTS]; H];
+            let mut smooth = [[false; JOINTS]; H];
+            for w in 0..H {
+                for j in 0..JOINTS {
+                    let (mut plus, mut minus) = (q64.clone(), q64.clone());
+                    plus[w][j] += h;
+                    minus[w][j] -= h;
+                    let (p, m) = (
+                        reference::cost(&scene, &plus, &config),
+                        reference::cost(&scene, &minus, &config),
+                    );
+                    smooth[w][j] = p.signature == here.signature && m.signature == here.signature;
+                    fd[w][j] = (p.value - m.value) / (2.0 * h);
+                    scale = scale.max(fd[w][j].abs());
+                }
+            }
+            assert!(scale > 0.0, "{finger} {kind:?}: no gradient");
+            for w in 0..H {
+                for j in 0..JOINTS {
+                    if !smooth[w][j] {
+                        continue;
+                    }
+                    kept += 1;
+                    let err = (f64::from(grad[w][j]) - fd[w][j]).abs();
+                    assert!(
+                        err <= 1e-4 * scale + 1e-7,
+                        "{finger} {kind:?} waypoint {w} joint {j}: adjoint {} vs fd {} (scale {scale})",
+                        grad[w][j],
+                        fd[w][j]
+                    );
+                }
+            }
+            assert!(kept * 2 >= H * JOINTS, "{finger} {kind:?}: only {kept} smooth entries");
+        }
     }
 }
 

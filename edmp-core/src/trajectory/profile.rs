@@ -77,7 +77,7 @@ impl Profile<'_> {
         let (t0, u0, v0, a) = self.piece(i);
         let s = (tau - t0).max(0.0);
         let u1 = (i + 1) as f32 / self.m;
-        let u = (u0 + s * (v0 + 0.5 * a * s)).clamp(u0, u1);
+        let u = (u0 + s * (v0 + 0.5 * a * s)).max(u0).min(u1);
         (u, (v0 + a * s).max(0.0), a)
     }
 
@@ -139,7 +139,8 @@ impl Profile<'_> {
         let inv = 1.0 / self.w;
         let mean = ub + self.integral(tau - self.w, tau, ub) * inv;
         Law {
-            u: mean.clamp(ub, u),
+            // max/min, not clamp: clamp panics when its bounds cross (a NaN, or rounding).
+            u: mean.max(ub).min(u),
             v: (self.increment(tau - self.w, tau) * inv).max(0.0),
             a: (v - vb) * inv,
             j: (a - ab) * inv,

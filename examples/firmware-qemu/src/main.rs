@@ -5,10 +5,13 @@
 //!
 //! ```text
 //! plan <name> <success|collision> <fingerprint> instructions <n> stack <bytes>
+//! timed <name> <fingerprint|none> instructions <n>
 //! ```
 //!
-//! `scripts/firmware` compares name, status and fingerprint with the host's plan of the same
-//! bytes. Instructions come from SysTick under `-icount shift=0` (calibrated at start against a
+//! The `timed` line is the chosen path's time parameterization (`edmp_core::trajectory`, the
+//! spline checked against the scene, Franka's limits, jerk-limited), for free plans (`none`
+//! otherwise). `scripts/firmware` compares name, status and fingerprints with the host's plan
+//! and trajectory of the same bytes. Instructions come from SysTick under `-icount shift=0` (calibrated at start against a
 //! loop of known length); stack is the high-water mark of a painted stack. Printing uses no
 //! `core::fmt`, so that the `panic-check` build links only what the planner needs.
 #![no_std]
@@ -24,10 +27,11 @@ use cortex_m_semihosting::hio::{self, HostStream};
 use edmp_core::Error;
 use edmp_core::guides::EDMP_GUIDES;
 use edmp_core::planner::{Plan, PlanConfig, Workspace, plan};
-use edmp_core::prior::{HORIZON, STEPS, Scratch, TimeEmbedding, initial_noise, predict_noise};
+use edmp_core::prior::{HORIZON, Path, STEPS, Scratch, TimeEmbedding, initial_noise, predict_noise};
 use edmp_core::rng::Rng;
 use edmp_core::robot::JOINTS;
 use edmp_core::scene::{Scene, SceneError};
+use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
 use edmp_core::wire::Problem;
 
 #[cfg(feature = "panic-report")]
@@ -71,6 +75,8 @@ const SCENES: &[(&str, &[u8])] = &[
 static mut SCRATCH: Scratch<1> = Scratch::new();
 /// The planner's gradients and noise predictions for the 12 rows (`.bss`).
 static mut WORK: Workspace<ROWS> = Workspace::new();
+/// The chosen path's time parameterization (`.bss`).
+static mut TIMED: Timed = Timed::new();
 
 /// SysTick wraps (every 2^24 ticks), counted by its exception.
 static WRAPS: AtomicU32 = AtomicU32::new(0);
@@ -246,6 +252,7 @@ impl Failure {
 struct Summary {
     free: bool,
     fingerprint: u64,
+    path: Path,
 }
 
 fn decode(bytes: &[u8]) -> Result<(Problem<OBSTACLES>, Scene<OBSTACLES>), Failure> {
@@ -271,10 +278,21 @@ fn plan_scene(bytes: &[u8], scratch: &mut Scratch<1>, work: &mut Workspace<ROWS>
         work,
     )
     .map_err(Failure::Plan)?;
+    let path = plan.paths.get(plan.best).copied().unwrap_or([[0.0; JOINTS]; HORIZON]);
     Ok(Summary {
         free: plan.is_free(),
         fingerprint: plan.fingerprint(),
+        path,
     })
+}
+
+/// Times a free plan's path as the host's `--timed` does: the spline checked against the scene
+/// (else the polyline), Franka's limits, jerk-limited.
+#[inline(never)]
+fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed) -> Result<u64, Failure> {
+    let (_, scene) = decode(bytes)?;
+    parameterize_checked(&scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, timed).map_err(Failure::Plan)?;
+    Ok(timed.fingerprint())
 }
 
 /// Ticks of one network evaluation of all 12 rows (noise between the scene's ends, step 255),
@@ -310,8 +328,9 @@ fn main() -> ! {
     while SYST::get_current() == 0 {}
 
     // SAFETY: `main` never returns and takes these references once; nothing else (no
-    // interrupt handler) touches SCRATCH or WORK.
-    let (scratch, work) = unsafe { (&mut *addr_of_mut!(SCRATCH), &mut *addr_of_mut!(WORK)) };
+    // interrupt handler) touches SCRATCH, WORK or TIMED.
+    let (scratch, work, timed) =
+        unsafe { (&mut *addr_of_mut!(SCRATCH), &mut *addr_of_mut!(WORK), &mut *addr_of_mut!(TIMED)) };
 
     let per_tick = instructions_per_tick();
     out.str("systick instructions-per-tick ").dec(per_tick).str("\n");
@@ -334,6 +353,25 @@ fn main() -> ! {
                     .str(" stack ")
                     .dec(stack as u64)
                     .str("\n");
+                out.strs(&["timed ", name, " "]);
+                if !plan.free {
+                    out.str("none instructions 0\n");
+                    continue;
+                }
+                paint_stack();
+                let began = ticks();
+                let result = time_path(bytes, &plan.path, timed);
+                let spent = (ticks() - began) * per_tick;
+                peak_stack = peak_stack.max(stack_high_water());
+                match result {
+                    Ok(fingerprint) => {
+                        out.hex(fingerprint).str(" instructions ").dec(spent).str("\n");
+                    }
+                    Err(e) => {
+                        failed = true;
+                        out.strs(&["error ", e.name(), "\n"]);
+                    }
+                }
             }
             Err(e) => {
                 failed = true;

@@ -1,0 +1,956 @@
+//! `edmp-host import-moveit`: a MoveIt planning scene (`moveit_msgs/PlanningScene` as YAML, e.g.
+//! from `rostopic echo` / `ros2 topic echo`) and optionally a `moveit_msgs/MotionPlanRequest`
+//! (YAML) as one `edmp-scene/1` document, validated through the host's JSON reader.
+//!
+//! What is read: `world.collision_objects[]` (BOX, SPHERE, CYLINDER primitives; the world pose
+//! of each is the object's `pose` times the primitive's pose), one object attached to
+//! `panda_hand` with one primitive (the held object), the start from the request's
+//! `start_state.joint_state` (else the scene's `robot_state.joint_state`), and the goal from
+//! `goal_constraints[0]`: joint constraints, or one position and one orientation constraint on
+//! `panda_link8`, `panda_hand` or `panda_grasptarget` (converted to the TCP). ROS quaternions
+//! are `[x, y, z, w]`; ours are `[w, x, y, z]`. Frames: `panda_link0` (our world) or `world`
+//! (the Panda MoveIt configuration's fixed virtual joint, identity).
+//!
+//! Everything that would change the problem and cannot be expressed (meshes, planes, cones,
+//! other frames, other links, octomaps, path constraints, padding, a second goal) is an error
+//! naming its YAML path; fields that do not change the geometry or the ends (names, stamps,
+//! colours, planner settings, the allowed collision matrix, which only ever permits contacts)
+//! are ignored. Unknown fields are errors, as in `edmp-scene/1`.
+
+use crate::Failure;
+use crate::json::{Problem, parse_problem};
+use core::fmt;
+use edmp_core::kinematics::forward;
+use edmp_core::robot::{FRAME_NAMES, HAND_FRAME, JOINT_NAMES, JOINTS, TCP_FRAME};
+use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
+use saphyr::{LoadableYamlNode, Scalar, Yaml};
+use serde_json::{Map, Value, json};
+use std::path::PathBuf;
+
+/// The finger opening `edmp-scene/1` holds when it has no `gripper` field (metres).
+const FINGER_OPENING: f64 = 0.025;
+/// How far two finger positions may differ and still be one opening (metres).
+const FINGER_TOLERANCE: f64 = 1e-6;
+/// How far a quaternion's norm may be from 1 (the scene format's own rule).
+const NORM_TOLERANCE: f64 = 1e-3;
+/// Frames we read as the world: our world is `panda_link0`; MoveIt's Panda configuration puts
+/// it at `world` through a fixed identity virtual joint.
+const WORLD_FRAMES: [&str; 2] = ["panda_link0", "world"];
+/// Finger joints: one opening for the whole plan (`gripper.finger`).
+const FINGER_JOINTS: [&str; 2] = ["panda_finger_joint1", "panda_finger_joint2"];
+
+/// Which of the two input files an error is in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// The `PlanningScene` YAML.
+    Scene,
+    /// The `MotionPlanRequest` YAML.
+    Request,
+}
+
+/// A field of the MoveIt input that is wrong or unsupported, by its YAML path.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ImportError {
+    /// The file it is in.
+    pub source: Source,
+    /// The YAML path, e.g. `world.collision_objects[2].meshes`.
+    pub path: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for ImportError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let file = match self.source {
+            Source::Scene => "scene",
+            Source::Request => "request",
+        };
+        if self.path.is_empty() {
+            write!(f, "{file}: {}", self.message)
+        } else {
+            write!(f, "{file}: {}: {}", self.path, self.message)
+        }
+    }
+}
+
+impl core::error::Error for ImportError {}
+
+/// Errors of one file, before the file is known.
+#[derive(Debug)]
+struct At {
+    path: String,
+    message: String,
+}
+
+type R<T> = Result<T, At>;
+
+fn at(path: &str, message: impl Into<String>) -> At {
+    At {
+        path: path.to_owned(),
+        message: message.into(),
+    }
+}
+
+fn join(path: &str, key: &str) -> String {
+    if path.is_empty() {
+        key.to_owned()
+    } else {
+        format!("{path}.{key}")
+    }
+}
+
+/// Parses one YAML document into a JSON value (string keys, finite numbers), naming the path of
+/// anything JSON cannot hold.
+fn load(text: &str) -> R<Value> {
+    let docs = Yaml::load_from_str(text).map_err(|e| at("", format!("not valid YAML: {e}")))?;
+    match docs.as_slice() {
+        [] => Ok(Value::Object(Map::new())),
+        [doc] => to_json(doc, ""),
+        _ => Err(at("", format!("{} YAML documents, expected one", docs.len()))),
+    }
+}
+
+fn to_json(node: &Yaml<'_>, path: &str) -> R<Value> {
+    match node {
+        Yaml::Value(Scalar::Null) => Ok(Value::Null),
+        Yaml::Value(Scalar::Boolean(b)) => Ok(Value::Bool(*b)),
+        Yaml::Value(Scalar::Integer(i)) => Ok(json!(i)),
+        Yaml::Value(Scalar::FloatingPoint(x)) => {
+            let x = x.into_inner();
+            serde_json::Number::from_f64(x)
+                .map(Value::Number)
+                .ok_or_else(|| at(path, format!("{x} is not a finite number")))
+        }
+        Yaml::Value(Scalar::String(s)) => Ok(Value::String(s.to_string())),
+        Yaml::Sequence(items) => items
+            .iter()
+            .enumerate()
+            .map(|(i, item)| to_json(item, &format!("{path}[{i}]")))
+            .collect::<R<Vec<_>>>()
+            .map(Value::Array),
+        Yaml::Mapping(map) => {
+            let mut out = Map::new();
+            for (k, v) in map {
+                let key = match k {
+                    Yaml::Value(Scalar::String(s)) => s.to_string(),
+                    Yaml::Value(Scalar::Integer(i)) => i.to_string(),
+                    other => return Err(at(path, format!("mapping key {other:?} is not a string"))),
+                };
+                let value = to_json(v, &join(path, &key))?;
+                if out.insert(key.clone(), value).is_some() {
+                    return Err(at(&join(path, &key), "duplicate key"));
+                }
+            }
+            Ok(Value::Object(out))
+        }
+        // Core-schema tags (`!!map`, `!!seq`) on collections are harmless; others are not ours.
+        Yaml::Tagged(tag, inner) if tag.is_yaml_core_schema() => to_json(inner, path),
+        Yaml::Tagged(tag, _) => Err(at(path, format!("YAML tag {tag} is not supported"))),
+        Yaml::Alias(_) => Err(at(path, "unresolved YAML alias")),
+        Yaml::Representation(text, ..) => Err(at(path, format!("unparsed YAML scalar {text:?}"))),
+        Yaml::BadValue => Err(at(path, "invalid YAML value")),
+    }
+}
+
+/// The mapping at `path` with only `allowed` keys (`null` reads as an empty mapping, as
+/// `rostopic echo` writes empty messages).
+fn mapping<'a>(v: &'a Value, path: &str, allowed: &[&str]) -> R<Option<&'a Map<String, Value>>> {
+    let map = match v {
+        Value::Null => return Ok(None),
+        Value::Object(map) => map,
+        _ => return Err(at(path, "expected a mapping")),
+    };
+    for key in map.keys() {
+        if !allowed.contains(&key.as_str()) {
+            return Err(at(
+                &join(path, key),
+                format!("unknown field (expected one of: {})", allowed.join(", ")),
+            ));
+        }
+    }
+    Ok(Some(map))
+}
+
+/// A sequence field (absent or `null`: empty).
+fn sequence<'a>(map: Option<&'a Map<String, Value>>, path: &str, key: &str) -> R<(&'a [Value], String)> {
+    let p = join(path, key);
+    match map.and_then(|m| m.get(key)) {
+        None | Some(Value::Null) => Ok((&[], p)),
+        Some(Value::Array(items)) => Ok((items.as_slice(), p)),
+        Some(_) => Err(at(&p, "expected a sequence")),
+    }
+}
+
+/// Refuses a non-empty sequence the importer cannot express.
+fn unsupported_if_any(map: Option<&Map<String, Value>>, path: &str, key: &str, why: &str) -> R<()> {
+    let (items, p) = sequence(map, path, key)?;
+    if items.is_empty() {
+        Ok(())
+    } else {
+        Err(at(&p, format!("not supported: {why}")))
+    }
+}
+
+fn number(v: &Value, path: &str) -> R<f64> {
+    v.as_f64()
+        .filter(|x| x.is_finite())
+        .ok_or_else(|| at(path, format!("expected a finite number, found {v}")))
+}
+
+/// A number field; ROS fills absent fields with 0.
+fn number_or_zero(map: Option<&Map<String, Value>>, path: &str, key: &str) -> R<f64> {
+    match map.and_then(|m| m.get(key)) {
+        None | Some(Value::Null) => Ok(0.0),
+        Some(v) => number(v, &join(path, key)),
+    }
+}
+
+fn string<'a>(map: Option<&'a Map<String, Value>>, path: &str, key: &str) -> R<&'a str> {
+    match map.and_then(|m| m.get(key)) {
+        None | Some(Value::Null) => Ok(""),
+        Some(Value::String(s)) => Ok(s),
+        Some(v) => Err(at(&join(path, key), format!("expected a string, found {v}"))),
+    }
+}
+
+fn vector(v: Option<&Value>, path: &str) -> R<Vector3<f64>> {
+    let map = mapping(v.unwrap_or(&Value::Null), path, &["x", "y", "z"])?;
+    Ok(Vector3::new(
+        number_or_zero(map, path, "x")?,
+        number_or_zero(map, path, "y")?,
+        number_or_zero(map, path, "z")?,
+    ))
+}
+
+/// A ROS quaternion `{x, y, z, w}`. All zeros is the identity (MoveIt's own reading of an unset
+/// orientation); otherwise the norm must be within 1e-3 of 1.
+fn orientation(v: Option<&Value>, path: &str) -> R<UnitQuaternion<f64>> {
+    let map = mapping(v.unwrap_or(&Value::Null), path, &["x", "y", "z", "w"])?;
+    let q = Quaternion::new(
+        number_or_zero(map, path, "w")?,
+        number_or_zero(map, path, "x")?,
+        number_or_zero(map, path, "y")?,
+        number_or_zero(map, path, "z")?,
+    );
+    let norm = q.norm();
+    if norm == 0.0 {
+        return Ok(UnitQuaternion::identity());
+    }
+    if (norm - 1.0).abs() > NORM_TOLERANCE {
+        return Err(at(path, format!("norm {norm:.4}, expected 1")));
+    }
+    Ok(UnitQuaternion::from_quaternion(q))
+}
+
+/// A `geometry_msgs/Pose` (absent: the identity).
+fn pose(v: Option<&Value>, path: &str) -> R<Isometry3<f64>> {
+    let map = mapping(v.unwrap_or(&Value::Null), path, &["position", "orientation"])?;
+    let position = vector(map.and_then(|m| m.get("position")), &join(path, "position"))?;
+    let rotation = orientation(map.and_then(|m| m.get("orientation")), &join(path, "orientation"))?;
+    Ok(Isometry3::from_parts(Translation3::from(position), rotation))
+}
+
+/// The frame of a `std_msgs/Header`, which must be one of `allowed`.
+fn frame(map: Option<&Map<String, Value>>, path: &str, allowed: &[&str]) -> R<String> {
+    let hp = join(path, "header");
+    let header = mapping(
+        map.and_then(|m| m.get("header")).unwrap_or(&Value::Null),
+        &hp,
+        &["seq", "stamp", "frame_id"],
+    )?;
+    let id = string(header, &hp, "frame_id")?;
+    let id = id.strip_prefix('/').unwrap_or(id);
+    if allowed.contains(&id) {
+        Ok(id.to_owned())
+    } else {
+        Err(at(
+            &join(&hp, "frame_id"),
+            format!("frame {id:?} is not supported (only {})", allowed.join(", ")),
+        ))
+    }
+}
+
+fn round(x: f64) -> f64 {
+    // Keep the JSON short and free of f64 dust (1e-12 is far below f32's resolution).
+    (x * 1e12).round() / 1e12
+}
+
+fn center_and_quaternion(p: &Isometry3<f64>) -> (Vec<f64>, Vec<f64>) {
+    let t = p.translation.vector;
+    let mut q = *p.rotation.quaternion();
+    if q.w < 0.0 {
+        q = -q;
+    }
+    (
+        vec![round(t.x), round(t.y), round(t.z)],
+        vec![round(q.w), round(q.i), round(q.j), round(q.k)],
+    )
+}
+
+/// One `shape_msgs/SolidPrimitive` placed at `placed`, as an `edmp-scene/1` primitive.
+fn primitive(v: &Value, path: &str, placed: &Isometry3<f64>) -> R<Value> {
+    let map = mapping(v, path, &["type", "dimensions"])?;
+    let tp = join(path, "type");
+    let kind = map
+        .and_then(|m| m.get("type"))
+        .and_then(Value::as_u64)
+        .ok_or_else(|| at(&tp, "expected the primitive type (1 BOX, 2 SPHERE, 3 CYLINDER)"))?;
+    let (dims, dp) = sequence(map, path, "dimensions")?;
+    let dims = dims
+        .iter()
+        .enumerate()
+        .map(|(i, d)| number(d, &format!("{dp}[{i}]")))
+        .collect::<R<Vec<f64>>>()?;
+    let expect = |n: usize, what: &str| {
+        if dims.len() == n {
+            Ok(())
+        } else {
+            Err(at(
+                &dp,
+                format!("expected {n} dimensions ({what}), found {}", dims.len()),
+            ))
+        }
+    };
+    let (center, quaternion) = center_and_quaternion(placed);
+    match kind {
+        1 => {
+            expect(3, "x, y, z")?;
+            Ok(json!({"type": "cuboid", "center": center, "dims": dims, "quaternion": quaternion}))
+        }
+        2 => {
+            expect(1, "radius")?;
+            Ok(json!({"type": "sphere", "center": center, "radius": dims[0]}))
+        }
+        3 => {
+            expect(2, "height, radius")?;
+            Ok(json!({
+                "type": "cylinder", "center": center, "radius": dims[1], "height": dims[0], "quaternion": quaternion,
+            }))
+        }
+        4 => Err(at(&tp, "CONE (4) is not supported (cuboid, sphere, cylinder)")),
+        other => Err(at(&tp, format!("unknown primitive type {other}"))),
+    }
+}
+
+const COLLISION_OBJECT: [&str; 13] = [
+    "header",
+    "pose",
+    "id",
+    "type",
+    "primitives",
+    "primitive_poses",
+    "meshes",
+    "mesh_poses",
+    "planes",
+    "plane_poses",
+    "subframe_names",
+    "subframe_poses",
+    "operation",
+];
+
+/// A `moveit_msgs/CollisionObject`: its primitives, in `frames` (the world, or the hand for an
+/// attached object), as `edmp-scene/1` primitives.
+fn collision_object(v: &Value, path: &str, frames: &[&str]) -> R<(String, Vec<Value>)> {
+    let map = mapping(v, path, &COLLISION_OBJECT)?;
+    let id = string(map, path, "id")?.to_owned();
+    frame(map, path, frames)?;
+    match map.and_then(|m| m.get("operation")) {
+        None | Some(Value::Null) => {}
+        Some(Value::Number(n)) if n.as_u64() == Some(0) => {}
+        Some(Value::String(s)) if s == "\0" || s == "b'\\x00'" => {}
+        Some(other) => {
+            return Err(at(
+                &join(path, "operation"),
+                format!("operation {other} is not supported (only ADD, 0: a full scene)"),
+            ));
+        }
+    }
+    unsupported_if_any(map, path, "meshes", "meshes (cuboid, sphere, cylinder primitives only)")?;
+    unsupported_if_any(map, path, "planes", "planes (cuboid, sphere, cylinder primitives only)")?;
+    let object_pose = pose(map.and_then(|m| m.get("pose")), &join(path, "pose"))?;
+    let (primitives, pp) = sequence(map, path, "primitives")?;
+    let (poses, posep) = sequence(map, path, "primitive_poses")?;
+    if primitives.len() != poses.len() {
+        return Err(at(
+            &posep,
+            format!("{} poses for {} primitives", poses.len(), primitives.len()),
+        ));
+    }
+    let mut out = Vec::new();
+    for (i, (prim, p)) in primitives.iter().zip(poses).enumerate() {
+        let placed = object_pose * pose(Some(p), &format!("{posep}[{i}]"))?;
+        out.push(primitive(prim, &format!("{pp}[{i}]"), &placed)?);
+    }
+    Ok((id, out))
+}
+
+/// `moveit_msgs/AttachedCollisionObject`s: at most one, on `panda_hand`, with one primitive
+/// (the held object, in the hand frame).
+fn attached(items: &[Value], path: &str) -> R<Option<(String, Value)>> {
+    let mut held = None;
+    for (i, item) in items.iter().enumerate() {
+        let ip = format!("{path}[{i}]");
+        let map = mapping(
+            item,
+            &ip,
+            &["link_name", "object", "touch_links", "detach_posture", "weight"],
+        )?;
+        let link = string(map, &ip, "link_name")?;
+        if link != FRAME_NAMES[HAND_FRAME] {
+            return Err(at(
+                &join(&ip, "link_name"),
+                format!("attached to {link:?}: only objects held by panda_hand are supported"),
+            ));
+        }
+        if held.is_some() {
+            return Err(at(&ip, "a second attached object: edmp-scene/1 holds one"));
+        }
+        let op = join(&ip, "object");
+        let (id, mut prims) = collision_object(
+            map.and_then(|m| m.get("object")).unwrap_or(&Value::Null),
+            &op,
+            &["", FRAME_NAMES[HAND_FRAME]],
+        )?;
+        if prims.len() != 1 {
+            return Err(at(
+                &join(&op, "primitives"),
+                format!("{} primitives: a held object is one primitive", prims.len()),
+            ));
+        }
+        held = prims.pop().map(|p| (id, p));
+    }
+    Ok(held)
+}
+
+const ROBOT_STATE: [&str; 4] = [
+    "joint_state",
+    "multi_dof_joint_state",
+    "attached_collision_objects",
+    "is_diff",
+];
+
+/// Finger openings read from joint states, each with its YAML path.
+type Fingers = Vec<(f64, String)>;
+
+/// What a `moveit_msgs/RobotState` holds for us.
+#[derive(Debug, Default)]
+struct State {
+    joints: Option<[f64; JOINTS]>,
+    held: Option<(String, Value)>,
+    fingers: Fingers,
+}
+
+fn robot_state(v: &Value, path: &str) -> R<State> {
+    let map = mapping(v, path, &ROBOT_STATE)?;
+    let mdp = join(path, "multi_dof_joint_state");
+    let mdof = mapping(
+        map.and_then(|m| m.get("multi_dof_joint_state")).unwrap_or(&Value::Null),
+        &mdp,
+        &["header", "joint_names", "transforms", "twist", "wrench"],
+    )?;
+    unsupported_if_any(
+        mdof,
+        &mdp,
+        "joint_names",
+        "multi-DOF joints (the Panda's base is fixed)",
+    )?;
+    let (items, ap) = sequence(map, path, "attached_collision_objects")?;
+    let held = attached(items, &ap)?;
+    let jp = join(path, "joint_state");
+    let js = mapping(
+        map.and_then(|m| m.get("joint_state")).unwrap_or(&Value::Null),
+        &jp,
+        &["header", "name", "position", "velocity", "effort"],
+    )?;
+    let (names, np) = sequence(js, &jp, "name")?;
+    let (positions, pp) = sequence(js, &jp, "position")?;
+    if names.is_empty() && positions.is_empty() {
+        return Ok(State {
+            held,
+            ..State::default()
+        });
+    }
+    if names.len() != positions.len() {
+        return Err(at(
+            &pp,
+            format!("{} positions for {} names", positions.len(), names.len()),
+        ));
+    }
+    let mut joints = [None; JOINTS];
+    let mut fingers = Vec::new();
+    for (i, (name, value)) in names.iter().zip(positions).enumerate() {
+        let name = name
+            .as_str()
+            .ok_or_else(|| at(&format!("{np}[{i}]"), "expected a joint name"))?;
+        let x = number(value, &format!("{pp}[{i}]"))?;
+        assign(&mut joints, &mut fingers, name, x, &format!("{np}[{i}]"))?;
+    }
+    Ok(State {
+        joints: Some(complete(joints, &np)?),
+        held,
+        fingers,
+    })
+}
+
+/// Records joint `name` = `x` (a finger's opening goes to `fingers`, with its path).
+fn assign(joints: &mut [Option<f64>; JOINTS], fingers: &mut Fingers, name: &str, x: f64, path: &str) -> R<()> {
+    if let Some(j) = JOINT_NAMES.iter().position(|n| *n == name) {
+        if joints[j].replace(x).is_some() {
+            return Err(at(path, format!("{name} given twice")));
+        }
+        Ok(())
+    } else if FINGER_JOINTS.contains(&name) {
+        fingers.push((x, path.to_owned()));
+        Ok(())
+    } else {
+        Err(at(
+            path,
+            format!("unknown joint {name:?} (panda_joint1..7 and the fingers)"),
+        ))
+    }
+}
+
+fn complete(joints: [Option<f64>; JOINTS], path: &str) -> R<[f64; JOINTS]> {
+    let mut out = [0.0; JOINTS];
+    for (j, (slot, q)) in out.iter_mut().zip(joints).enumerate() {
+        *slot = q.ok_or_else(|| at(path, format!("{} is missing", JOINT_NAMES[j])))?;
+    }
+    Ok(out)
+}
+
+/// Links rigidly attached to the TCP that a pose goal may name, and their TCP offset.
+fn tcp_offset(link: &str, path: &str) -> R<Isometry3<f64>> {
+    // After joint 7 nothing moves (the fingers are held): these frames are rigid with the TCP.
+    let rigid = ["panda_link8", FRAME_NAMES[HAND_FRAME], FRAME_NAMES[TCP_FRAME]];
+    let frame = rigid
+        .contains(&link)
+        .then(|| FRAME_NAMES.iter().position(|n| *n == link))
+        .flatten()
+        .ok_or_else(|| {
+            at(
+                path,
+                format!(
+                    "link {link:?} is not supported for a pose goal (one of {})",
+                    rigid.join(", ")
+                ),
+            )
+        })?;
+    let k = forward::<f64>(&[0.0; JOINTS]).map_err(|e| at(path, e.to_string()))?;
+    let iso = |p: &edmp_core::kinematics::Pose<f64>| {
+        let r = Rotation3::from_matrix_unchecked(Matrix3::from(p.rotation));
+        Isometry3::from_parts(
+            Translation3::from(p.translation),
+            UnitQuaternion::from_rotation_matrix(&r),
+        )
+    };
+    Ok(iso(&k.frames[frame]).inverse() * iso(&k.frames[TCP_FRAME]))
+}
+
+/// The goal of `moveit_msgs/Constraints`: joints (and finger openings), or the TCP pose.
+fn goal(v: &Value, path: &str) -> R<(Value, Fingers)> {
+    let map = mapping(
+        v,
+        path,
+        &[
+            "name",
+            "joint_constraints",
+            "position_constraints",
+            "orientation_constraints",
+            "visibility_constraints",
+        ],
+    )?;
+    unsupported_if_any(map, path, "visibility_constraints", "visibility constraints")?;
+    let (jc, jcp) = sequence(map, path, "joint_constraints")?;
+    let (pc, pcp) = sequence(map, path, "position_constraints")?;
+    let (oc, ocp) = sequence(map, path, "orientation_constraints")?;
+    if !jc.is_empty() {
+        if !pc.is_empty() || !oc.is_empty() {
+            return Err(at(path, "joint and pose constraints together: give one kind"));
+        }
+        let mut joints = [None; JOINTS];
+        let mut fingers = Vec::new();
+        for (i, c) in jc.iter().enumerate() {
+            let cp = format!("{jcp}[{i}]");
+            let m = mapping(
+                c,
+                &cp,
+                &["joint_name", "position", "tolerance_above", "tolerance_below", "weight"],
+            )?;
+            let name = string(m, &cp, "joint_name")?;
+            let x = number(
+                m.and_then(|m| m.get("position")).unwrap_or(&Value::Null),
+                &join(&cp, "position"),
+            )?;
+            assign(&mut joints, &mut fingers, name, x, &join(&cp, "joint_name"))?;
+        }
+        return Ok((json!({"joints": complete(joints, &jcp)?}), fingers));
+    }
+    match (pc.len(), oc.len()) {
+        (1, 1) => {}
+        (0, 0) => return Err(at(path, "no joint, position or orientation constraint")),
+        (1, 0) => return Err(at(path, "a position constraint without an orientation constraint")),
+        (0, 1) => return Err(at(path, "an orientation constraint without a position constraint")),
+        _ => return Err(at(path, "more than one position or orientation constraint")),
+    }
+    let (pp, op) = (format!("{pcp}[0]"), format!("{ocp}[0]"));
+    let pm = mapping(
+        &pc[0],
+        &pp,
+        &[
+            "header",
+            "link_name",
+            "target_point_offset",
+            "constraint_region",
+            "weight",
+        ],
+    )?;
+    let om = mapping(
+        &oc[0],
+        &op,
+        &[
+            "header",
+            "orientation",
+            "link_name",
+            "absolute_x_axis_tolerance",
+            "absolute_y_axis_tolerance",
+            "absolute_z_axis_tolerance",
+            "parameterization",
+            "weight",
+        ],
+    )?;
+    frame(pm, &pp, &WORLD_FRAMES)?;
+    frame(om, &op, &WORLD_FRAMES)?;
+    let link = string(pm, &pp, "link_name")?;
+    let olink = string(om, &op, "link_name")?;
+    if link != olink {
+        return Err(at(
+            &join(&op, "link_name"),
+            format!("{olink:?}, but the position constraint is on {link:?}"),
+        ));
+    }
+    let offset = tcp_offset(link, &join(&pp, "link_name"))?;
+    let point_offset = vector(
+        pm.and_then(|m| m.get("target_point_offset")),
+        &join(&pp, "target_point_offset"),
+    )?;
+    let rp = join(&pp, "constraint_region");
+    let region = mapping(
+        pm.and_then(|m| m.get("constraint_region")).unwrap_or(&Value::Null),
+        &rp,
+        &["primitives", "primitive_poses", "meshes", "mesh_poses"],
+    )?;
+    unsupported_if_any(
+        region,
+        &rp,
+        "meshes",
+        "mesh regions (the region's first primitive pose is the target)",
+    )?;
+    let (poses, posep) = sequence(region, &rp, "primitive_poses")?;
+    let target = match poses {
+        [] => {
+            return Err(at(
+                &posep,
+                "missing: the target position is the region's primitive pose",
+            ));
+        }
+        [p] => pose(Some(p), &format!("{posep}[0]"))?.translation.vector,
+        _ => return Err(at(&posep, "more than one region: the target must be one point")),
+    };
+    let rotation = orientation(om.and_then(|m| m.get("orientation")), &join(&op, "orientation"))?;
+    // The constrained point is `link · point_offset`; place the link so it lands on the target.
+    let link_pose = Isometry3::from_parts(Translation3::from(target - rotation * point_offset), rotation);
+    let (position, quaternion) = center_and_quaternion(&(link_pose * offset));
+    Ok((
+        json!({"pose": {"position": position, "quaternion": quaternion}}),
+        Vec::new(),
+    ))
+}
+
+const PLANNING_SCENE: [&str; 10] = [
+    "name",
+    "robot_state",
+    "robot_model_name",
+    "fixed_frame_transforms",
+    "allowed_collision_matrix",
+    "link_padding",
+    "link_scale",
+    "object_colors",
+    "world",
+    "is_diff",
+];
+
+/// Padding must be 0 and scale 1 (`moveit_msgs/LinkPadding` / `LinkScale`): the checker's robot
+/// is the URDF's.
+fn link_adjustments(map: Option<&Map<String, Value>>, key: &str, neutral: f64) -> R<()> {
+    let (items, p) = sequence(map, "", key)?;
+    for (i, item) in items.iter().enumerate() {
+        let ip = format!("{p}[{i}]");
+        let m = mapping(item, &ip, &["link_name", key.strip_prefix("link_").unwrap_or(key)])?;
+        let field = key.strip_prefix("link_").unwrap_or(key);
+        let x = number_or_zero(m, &ip, field)?;
+        if (x - neutral).abs() > 1e-12 {
+            return Err(at(
+                &join(&ip, field),
+                format!("{x}: not supported (the robot is checked as its URDF, {field} {neutral})"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn scene_part(v: &Value) -> R<(Vec<Value>, Vec<String>, State)> {
+    let map = mapping(v, "", &PLANNING_SCENE)?;
+    let model = string(map, "", "robot_model_name")?;
+    if !model.is_empty() && model != "panda" {
+        return Err(at("robot_model_name", format!("{model:?}: only the Panda (\"panda\")")));
+    }
+    link_adjustments(map, "link_padding", 0.0)?;
+    link_adjustments(map, "link_scale", 1.0)?;
+    let state = match map.and_then(|m| m.get("robot_state")) {
+        Some(rs) => robot_state(rs, "robot_state")?,
+        None => State::default(),
+    };
+    let world = mapping(
+        map.and_then(|m| m.get("world")).unwrap_or(&Value::Null),
+        "world",
+        &["collision_objects", "octomap"],
+    )?;
+    if let Some(octo) = world.and_then(|w| w.get("octomap")) {
+        let om = mapping(octo, "world.octomap", &["header", "origin", "octomap"])?;
+        let inner = mapping(
+            om.and_then(|m| m.get("octomap")).unwrap_or(&Value::Null),
+            "world.octomap.octomap",
+            &["header", "binary", "id", "resolution", "data"],
+        )?;
+        unsupported_if_any(inner, "world.octomap.octomap", "data", "octomaps (primitives only)")?;
+    }
+    let (objects, op) = sequence(world, "world", "collision_objects")?;
+    let mut obstacles = Vec::new();
+    let mut ids = Vec::new();
+    for (i, o) in objects.iter().enumerate() {
+        let (id, prims) = collision_object(o, &format!("{op}[{i}]"), &WORLD_FRAMES)?;
+        for p in prims {
+            obstacles.push(p);
+            ids.push(id.clone());
+        }
+    }
+    Ok((obstacles, ids, state))
+}
+
+const MOTION_PLAN_REQUEST: [&str; 16] = [
+    "workspace_parameters",
+    "start_state",
+    "goal_constraints",
+    "path_constraints",
+    "trajectory_constraints",
+    "reference_trajectories",
+    "pipeline_id",
+    "planner_id",
+    "group_name",
+    "num_planning_attempts",
+    "allowed_planning_time",
+    "max_velocity_scaling_factor",
+    "max_acceleration_scaling_factor",
+    "cartesian_speed_end_effector_link",
+    "cartesian_speed_limited_link",
+    "max_cartesian_speed",
+];
+
+fn request_part(v: &Value) -> R<(State, (Value, Fingers))> {
+    let map = mapping(v, "", &MOTION_PLAN_REQUEST)?;
+    let group = string(map, "", "group_name")?;
+    if !["", "panda_arm", "panda_manipulator"].contains(&group) {
+        return Err(at(
+            "group_name",
+            format!("{group:?}: only panda_arm or panda_manipulator"),
+        ));
+    }
+    if let Some(pc) = map.and_then(|m| m.get("path_constraints")) {
+        let pm = mapping(
+            pc,
+            "path_constraints",
+            &[
+                "name",
+                "joint_constraints",
+                "position_constraints",
+                "orientation_constraints",
+                "visibility_constraints",
+            ],
+        )?;
+        for key in [
+            "joint_constraints",
+            "position_constraints",
+            "orientation_constraints",
+            "visibility_constraints",
+        ] {
+            unsupported_if_any(pm, "path_constraints", key, "path constraints")?;
+        }
+    }
+    if let Some(tc) = map.and_then(|m| m.get("trajectory_constraints")) {
+        let tm = mapping(tc, "trajectory_constraints", &["constraints"])?;
+        unsupported_if_any(tm, "trajectory_constraints", "constraints", "trajectory constraints")?;
+    }
+    unsupported_if_any(map, "", "reference_trajectories", "reference trajectories")?;
+    let state = match map.and_then(|m| m.get("start_state")) {
+        Some(s) => robot_state(s, "start_state")?,
+        None => State::default(),
+    };
+    let (goals, gp) = sequence(map, "", "goal_constraints")?;
+    let goal = match goals {
+        [] => return Err(at(&gp, "missing: the request has no goal")),
+        [g] => goal(g, &format!("{gp}[0]"))?,
+        _ => return Err(at(&format!("{gp}[1]"), "a second goal: edmp-scene/1 has one")),
+    };
+    Ok((state, goal))
+}
+
+/// Reads a MoveIt `PlanningScene` (and optionally a `MotionPlanRequest`) into an
+/// `edmp-scene/1` document. The start is the request's start state, else the scene's robot
+/// state; without a request the goal is the start (edit it before planning). The result is not
+/// yet validated: see [`import_validated`].
+pub fn import(scene_yaml: &str, request_yaml: Option<&str>) -> Result<Value, ImportError> {
+    let in_scene = |e: At| ImportError {
+        source: Source::Scene,
+        path: e.path,
+        message: e.message,
+    };
+    let in_request = |e: At| ImportError {
+        source: Source::Request,
+        path: e.path,
+        message: e.message,
+    };
+    let (obstacles, ids, scene_state) = load(scene_yaml).and_then(|v| scene_part(&v)).map_err(in_scene)?;
+    let request = match request_yaml {
+        Some(text) => Some(load(text).and_then(|v| request_part(&v)).map_err(in_request)?),
+        None => None,
+    };
+    let tag = |fingers: Fingers, source: Source| {
+        fingers
+            .into_iter()
+            .map(move |(x, path)| (x, path, source))
+            .collect::<Vec<_>>()
+    };
+    let (start, goal, held, fingers) = match request {
+        Some((state, (goal, goal_fingers))) => {
+            // As MoveIt merges a start state into the scene's: fingers the request does not
+            // name stay where the scene's robot state has them.
+            let scene_fingers = tag(scene_state.fingers, Source::Scene);
+            let (start, mut fingers) = match state.joints {
+                Some(q) if !state.fingers.is_empty() => (q, tag(state.fingers, Source::Request)),
+                Some(q) => (q, scene_fingers),
+                None => (
+                    scene_state.joints.ok_or_else(|| ImportError {
+                        source: Source::Request,
+                        path: "start_state.joint_state".into(),
+                        message: "no start: neither the request nor the scene's robot_state has a joint state".into(),
+                    })?,
+                    scene_fingers,
+                ),
+            };
+            fingers.extend(tag(goal_fingers, Source::Request));
+            let held = match (state.held, scene_state.held) {
+                (Some(_), Some(_)) => {
+                    return Err(ImportError {
+                        source: Source::Request,
+                        path: "start_state.attached_collision_objects".into(),
+                        message: "the scene's robot_state holds an object too: edmp-scene/1 holds one".into(),
+                    });
+                }
+                (a, b) => a.or(b),
+            };
+            (start, goal, held, fingers)
+        }
+        None => {
+            let start = scene_state.joints.ok_or_else(|| ImportError {
+                source: Source::Scene,
+                path: "robot_state.joint_state".into(),
+                message: "no start: give a request with a start_state, or a joint state here".into(),
+            })?;
+            let fingers = tag(scene_state.fingers, Source::Scene);
+            (start, json!({"joints": start}), scene_state.held, fingers)
+        }
+    };
+    // Both fingers, at the start and the goal: one opening for the whole plan.
+    let opening = fingers.first().map(|f| f.0);
+    if let (Some(w), Some((_, first, _))) = (opening, fingers.first())
+        && let Some((x, path, source)) = fingers.iter().find(|f| (f.0 - w).abs() > FINGER_TOLERANCE)
+    {
+        return Err(ImportError {
+            source: *source,
+            path: path.clone(),
+            message: format!(
+                "finger at {x} m, but {first} is at {w} m: the fingers hold one opening for the whole plan"
+            ),
+        });
+    }
+    let mut doc = json!({
+        "format": "edmp-scene/1",
+        "obstacles": obstacles,
+        "start": start,
+        "goal": goal,
+        "meta": {
+            "source": "moveit",
+            "object_ids": ids,
+            "goal_from": if request_yaml.is_some() { "request" } else { "start (no request)" },
+        },
+    });
+    if let Some(w) = opening.filter(|w| (w - FINGER_OPENING).abs() > FINGER_TOLERANCE) {
+        doc["gripper"] = json!({ "finger": w });
+    }
+    if let Some((id, object)) = held {
+        doc["held_object"] = object;
+        doc["meta"]["held_object_id"] = json!(id);
+    }
+    Ok(doc)
+}
+
+/// [`import`], then the document through the host's `edmp-scene/1` reader (the same checks
+/// as `edmp-host plan`: limits, valid ends, quaternions).
+pub fn import_validated(scene_yaml: &str, request_yaml: Option<&str>) -> Result<(Value, Problem), String> {
+    let doc = import(scene_yaml, request_yaml).map_err(|e| e.to_string())?;
+    let problem =
+        parse_problem(&doc.to_string()).map_err(|e| format!("the imported edmp-scene/1 is not valid: {e}"))?;
+    Ok((doc, problem))
+}
+
+/// Arguments of `edmp-host import-moveit`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The MoveIt planning scene (`moveit_msgs/PlanningScene` as YAML).
+    #[arg(long)]
+    scene: PathBuf,
+    /// The motion plan request (`moveit_msgs/MotionPlanRequest` as YAML): start and goal.
+    #[arg(long)]
+    request: Option<PathBuf>,
+    /// Write the `edmp-scene/1` JSON here instead of standard output.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+}
+
+/// Imports, validates and writes the scene.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let read = |p: &PathBuf| std::fs::read_to_string(p).map_err(|e| Failure::Input(format!("{}: {e}", p.display())));
+    let scene = read(&args.scene)?;
+    let request = args.request.as_ref().map(read).transpose()?;
+    let doc = import(&scene, request.as_deref()).map_err(|e| {
+        let file = match (e.source, &args.request) {
+            (Source::Request, Some(r)) => r,
+            _ => &args.scene,
+        };
+        if e.path.is_empty() {
+            Failure::Input(format!("{}: {}", file.display(), e.message))
+        } else {
+            Failure::Input(format!("{}: {}: {}", file.display(), e.path, e.message))
+        }
+    })?;
+    parse_problem(&doc.to_string())
+        .map_err(|e| Failure::Input(format!("the imported edmp-scene/1 is not valid: {e}")))?;
+    let text = serde_json::to_string_pretty(&doc).map_err(|e| Failure::Input(e.to_string()))? + "\n";
+    match &args.output {
+        Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display()))),
+        None => {
+            print!("{text}");
+            Ok(())
+        }
+    }
+}

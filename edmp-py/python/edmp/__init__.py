@@ -1,0 +1,344 @@
+"""EDMP motion planning for the Franka Panda, from Python.
+
+The planner, kinematics, checker and IK are edmp-rs's (Rust, ``edmp._edmp``); this module is
+the typed, numpy-facing API over them. Scenes are ``edmp-scene/1`` documents read by the same
+reader as ``edmp-host plan`` (so errors name the same JSON paths), and a :class:`Plan` is the
+CLI's ``edmp-plan/1`` document, parsed.
+
+>>> import edmp
+>>> scene = edmp.Scene.from_file("examples/wall.json")
+>>> plan = edmp.plan(scene, seed=0)
+>>> plan.status, plan.waypoints.shape
+('success', (50, 7))
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Mapping, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _edmp
+from ._edmp import PlanError, SceneError
+
+__all__ = [
+    "Candidate",
+    "CheckReport",
+    "Plan",
+    "PlanError",
+    "Pose",
+    "Scene",
+    "SceneError",
+    "check",
+    "fk",
+    "ik",
+    "import_moveit",
+    "plan",
+]
+
+Array = npt.NDArray[np.float64]
+ArrayLike = Union[npt.ArrayLike, Sequence[float]]
+
+
+def _vector(x: ArrayLike, n: int, what: str) -> list[float]:
+    a = np.asarray(x, dtype=np.float64)
+    if a.shape != (n,):
+        raise ValueError(f"{what}: expected shape ({n},), found {a.shape}")
+    return [float(v) for v in a]
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A TCP pose: ``position`` (m, world frame) and ``quaternion`` ``[w, x, y, z]``."""
+
+    position: Array
+    quaternion: Array
+
+
+class Scene:
+    """A validated ``edmp-scene/1`` problem: obstacles, held object, start and goal.
+
+    Build one with :meth:`from_file`, :meth:`from_json`, :meth:`from_dict` or
+    :func:`import_moveit`. Invalid input raises :class:`SceneError` whose message names the
+    field by its JSON path (``obstacles[0].quaternion: norm 0.71, expected 1``).
+    """
+
+    __slots__ = ("_doc", "_text")
+
+    def __init__(self, document: Mapping[str, Any]) -> None:
+        text = json.dumps(document)
+        _edmp.validate(text)
+        self._doc: dict[str, Any] = json.loads(text)
+        self._text = text
+
+    @classmethod
+    def from_dict(cls, document: Mapping[str, Any]) -> "Scene":
+        """A scene from a dict shaped like the JSON document."""
+        return cls(document)
+
+    @classmethod
+    def from_json(cls, text: str) -> "Scene":
+        """A scene from JSON text."""
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise SceneError(f"not valid JSON: {e}") from None
+        if not isinstance(doc, dict):
+            raise SceneError("expected an object")
+        return cls(doc)
+
+    @classmethod
+    def from_file(cls, path: Union[str, os.PathLike[str]]) -> "Scene":
+        """A scene from an ``edmp-scene/1`` JSON file."""
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+        try:
+            return cls.from_json(text)
+        except SceneError as e:
+            raise SceneError(f"{os.fspath(path)}: {e}") from None
+
+    @property
+    def start(self) -> Array:
+        """The start configuration, shape ``(7,)``."""
+        return np.asarray(self._doc["start"], dtype=np.float64)
+
+    @property
+    def goal(self) -> Union[Array, Pose]:
+        """The goal: joints, shape ``(7,)``, or a TCP :class:`Pose` (solved by IK when planning)."""
+        goal = self._doc["goal"]
+        if "joints" in goal:
+            return np.asarray(goal["joints"], dtype=np.float64)
+        pose = goal["pose"]
+        return Pose(
+            np.asarray(pose["position"], dtype=np.float64),
+            np.asarray(pose["quaternion"], dtype=np.float64),
+        )
+
+    @property
+    def obstacles(self) -> list[dict[str, Any]]:
+        """The obstacles as in the document (a copy)."""
+        return json.loads(json.dumps(self._doc["obstacles"]))
+
+    @property
+    def held_object(self) -> Optional[dict[str, Any]]:
+        """The primitive held in the hand frame, if any (a copy)."""
+        held = self._doc.get("held_object")
+        return None if held is None else dict(held)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The document (a copy): edit it and build a new scene with :meth:`from_dict`."""
+        return json.loads(self._text)
+
+    def to_json(self, indent: Optional[int] = None) -> str:
+        """The document as JSON text."""
+        return json.dumps(self._doc, indent=indent)
+
+    def with_goal(self, joints: ArrayLike) -> "Scene":
+        """The same scene with a joint goal."""
+        doc = self.to_dict()
+        doc["goal"] = {"joints": _vector(joints, 7, "joints")}
+        return Scene(doc)
+
+    def __repr__(self) -> str:
+        kind = "joints" if "joints" in self._doc["goal"] else "pose"
+        return f"Scene({len(self._doc['obstacles'])} obstacles, {kind} goal)"
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One trajectory of the ensemble (``Plan.candidates``)."""
+
+    guide: int
+    collision_free: bool
+    swept_volume: float
+    waypoints: Array
+
+
+@dataclass(frozen=True)
+class Plan:
+    """An ``edmp-plan/1`` document, parsed: the CLI's plan for the same scene and seed."""
+
+    status: str
+    """``"success"`` (passed the exact checker) or ``"collision"`` (least colliding returned)."""
+    waypoints: Array
+    """The chosen trajectory, shape ``(50, 7)``."""
+    guide: int
+    stage: str
+    """Which stage won: ``diffusion``, ``reseeded``, ``search`` or ``none``."""
+    costs: dict[str, float]
+    seed: int
+    timing_ms: dict[str, float]
+    candidates: Optional[list[Candidate]] = None
+    search: Optional[dict[str, Any]] = None
+    trajectory: Optional[dict[str, Any]] = None
+    document: dict[str, Any] = field(default_factory=dict, repr=False)
+    """The whole document as the CLI writes it."""
+
+    @property
+    def success(self) -> bool:
+        """Whether the waypoints passed the planner's exact collision check."""
+        return self.status == "success"
+
+    @classmethod
+    def from_document(cls, doc: Mapping[str, Any]) -> "Plan":
+        """A plan from a parsed ``edmp-plan/1`` document."""
+        cands = doc.get("candidates")
+        return cls(
+            status=doc["status"],
+            waypoints=np.asarray(doc["waypoints"], dtype=np.float64),
+            guide=int(doc["guide"]),
+            stage=doc["stage"],
+            costs=dict(doc["costs"]),
+            seed=int(doc["seed"]),
+            timing_ms=dict(doc["timing_ms"]),
+            candidates=None
+            if cands is None
+            else [
+                Candidate(
+                    guide=int(c["guide"]),
+                    collision_free=bool(c["collision_free"]),
+                    swept_volume=float(c["swept_volume"]),
+                    waypoints=np.asarray(c["waypoints"], dtype=np.float64),
+                )
+                for c in cands
+            ],
+            search=doc.get("search"),
+            trajectory=_trajectory(doc.get("trajectory")),
+            document=dict(doc),
+        )
+
+
+def _scene_text(scene: Union[Scene, Mapping[str, Any], str]) -> str:
+    if isinstance(scene, Scene):
+        return scene._text
+    if isinstance(scene, str):
+        return Scene.from_json(scene)._text
+    return Scene.from_dict(scene)._text
+
+
+def _trajectory(t: Optional[Mapping[str, Any]]) -> Optional[dict[str, Any]]:
+    """The document's ``trajectory`` with its points as numpy arrays."""
+    if t is None:
+        return None
+    out = {k: v for k, v in t.items() if k != "points"}
+    points = t["points"]
+    for key in ("positions", "velocities", "accelerations"):
+        out[key] = np.asarray([p[key] for p in points], dtype=np.float64).reshape(-1, 7)
+    out["time_from_start"] = np.asarray([p["time_from_start"] for p in points], dtype=np.float64)
+    return out
+
+
+def plan(
+    scene: Union[Scene, Mapping[str, Any]],
+    seed: int = 0,
+    candidates: bool = False,
+    timed: bool = False,
+    rate: float = 100.0,
+    velocity_scale: float = 1.0,
+    acceleration_scale: float = 1.0,
+) -> Plan:
+    """Plans with EDMP (the shipped configuration, as ``edmp-host plan``).
+
+    ``candidates=True`` adds every trajectory of the ensemble. ``timed=True`` adds
+    ``Plan.trajectory``, as ``edmp-host plan --timed``: the path timed within Franka's velocity,
+    acceleration and jerk limits times ``velocity_scale`` / ``acceleration_scale`` (each in
+    (0, 1], else ``ValueError``), from rest to rest, sampled at ``rate`` Hz (at most 1000); a
+    dict shaped like ROS ``JointTrajectory`` whose ``positions``, ``velocities``,
+    ``accelerations`` are ``(n, 7)`` arrays and ``time_from_start`` an ``(n,)`` array. A colliding
+    plan is not timed (``trajectory`` is ``None``). The GIL is released while planning. Raises
+    :class:`SceneError` for bad input and :class:`PlanError` when the core refuses the problem
+    (for example an unreachable pose goal). A plan with ``status == "collision"`` is returned,
+    not raised (the CLI's exit 1).
+    """
+    if seed < 0:
+        raise ValueError(f"seed: {seed} is negative")
+    doc = json.loads(
+        _edmp.plan(_scene_text(scene), seed, candidates, timed, rate, velocity_scale, acceleration_scale)
+    )
+    return Plan.from_document(doc)
+
+
+def fk(q: ArrayLike) -> dict[str, Any]:
+    """Forward kinematics, as ``edmp-host fk --json``: ``tcp``, ``frames`` (13 link frames),
+    ``collision_boxes`` (11, with ``half_extents``), ``within_soft_limits``. Positions in metres,
+    quaternions ``[w, x, y, z]``, both as numpy arrays."""
+    report = json.loads(_edmp.fk(_vector(q, 7, "q")))
+
+    def arrays(p: dict[str, Any]) -> dict[str, Any]:
+        out = dict(p)
+        for key in ("position", "quaternion", "half_extents"):
+            if key in out:
+                out[key] = np.asarray(out[key], dtype=np.float64)
+        return out
+
+    report["joints"] = np.asarray(report["joints"], dtype=np.float64)
+    report["tcp"] = arrays(report["tcp"])
+    report["frames"] = [arrays(f) for f in report["frames"]]
+    report["collision_boxes"] = [arrays(b) for b in report["collision_boxes"]]
+    return report
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """The exact checker's verdict on a trajectory; truthy when collision-free."""
+
+    free: bool
+    states: int
+    """States checked: waypoints and interpolated states (steps of at most 0.01 rad)."""
+    colliding_states: int
+    first_contact: Optional[dict[str, Any]]
+    """``{"segment", "step", "contact"}`` of the first contact, e.g. ``panda_hand touches obstacles[1]``."""
+
+    def __bool__(self) -> bool:
+        return self.free
+
+
+def check(scene: Union[Scene, Mapping[str, Any]], waypoints: ArrayLike) -> CheckReport:
+    """Checks a ``(50, 7)`` trajectory in the scene with the core's exact checker
+    (``checker::check_trajectory``, the rule of a solved problem; every contact counted)."""
+    w = np.asarray(waypoints, dtype=np.float64)
+    if w.ndim != 2 or w.shape[1] != 7:
+        raise ValueError(f"waypoints: expected shape (50, 7), found {w.shape}")
+    r = json.loads(_edmp.check(_scene_text(scene), w.tolist()))
+    return CheckReport(r["free"], r["states"], r["colliding_states"], r["first_contact"])
+
+
+def ik(
+    scene: Union[Scene, Mapping[str, Any]],
+    position: ArrayLike,
+    quaternion: ArrayLike,
+) -> Optional[Array]:
+    """Joints that put the TCP at ``position`` / ``quaternion`` (``[w, x, y, z]``), within the
+    limits and collision-free in the scene, nearest its start: the core IK as a pose goal
+    uses it. ``None`` when no solution is found."""
+    q = _edmp.ik(
+        _scene_text(scene),
+        _vector(position, 3, "position"),
+        _vector(quaternion, 4, "quaternion"),
+    )
+    return None if q is None else np.asarray(q, dtype=np.float64)
+
+
+def import_moveit(
+    scene_yaml: Union[str, os.PathLike[str]],
+    request_yaml: Union[str, os.PathLike[str], None] = None,
+) -> Scene:
+    """A MoveIt planning scene (``moveit_msgs/PlanningScene`` YAML) and optionally a motion
+    plan request (``moveit_msgs/MotionPlanRequest`` YAML) as a :class:`Scene`, as
+    ``edmp-host import-moveit``. Each argument is YAML text or a path to a file. Unsupported
+    entries (meshes, planes, other frames or links...) raise :class:`SceneError` naming their
+    YAML path. Without a request the start is the scene's robot state and the goal equals it
+    (set one with :meth:`Scene.with_goal`)."""
+
+    def text(x: Union[str, os.PathLike[str]]) -> str:
+        if isinstance(x, os.PathLike) or (isinstance(x, str) and "\n" not in x and os.path.isfile(x)):
+            with open(x, encoding="utf-8") as f:
+                return f.read()
+        return str(x)
+
+    doc = _edmp.import_moveit(text(scene_yaml), None if request_yaml is None else text(request_yaml))
+    return Scene.from_json(doc)

@@ -1,0 +1,263 @@
+//! `edmp._edmp`: the native half of the `edmp` Python package. Every function takes and returns
+//! plain values or JSON text; the typed, numpy-facing API is `python/edmp/__init__.py`.
+//!
+//! Scenes go through the host's one reader of `edmp-scene/1` (`edmp_host::json`), plans through
+//! its planner driver and its one writer of `edmp-plan/1` (`edmp_host::plan_cmd`), so a plan
+//! from Python is the CLI's document. Planning releases the GIL.
+
+use edmp_core::checker::{CheckConfig, Contact, check_trajectory};
+use edmp_core::kinematics::{Pose, forward};
+use edmp_core::planner::PlanConfig;
+use edmp_core::prior::HORIZON;
+use edmp_core::robot::{BODY_NAMES, FRAME_NAMES, JOINT_NAMES, JOINTS, PANDA};
+use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
+use edmp_host::Failure;
+use edmp_host::json::{Goal, Problem, joint_goal, parse_problem};
+use edmp_host::plan_cmd::{add_trajectory, chosen_guides, plan_document, plan_problem};
+use edmp_host::timed::TimedRequest;
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use serde_json::{Value, json};
+use std::time::Instant;
+
+create_exception!(
+    edmp,
+    SceneError,
+    PyValueError,
+    "Invalid scene input. The message names the offending field by its JSON (or, for MoveIt input, YAML) path, as the CLI does: `obstacles[0].quaternion: norm 0.71, expected 1`."
+);
+create_exception!(
+    edmp,
+    PlanError,
+    PyRuntimeError,
+    "The planner or a core routine refused the problem (e.g. an unreachable pose goal)."
+);
+
+fn scene_error(e: impl ToString) -> PyErr {
+    SceneError::new_err(e.to_string())
+}
+
+fn failure(e: Failure) -> PyErr {
+    match e {
+        Failure::Input(m) | Failure::NoPath(m) => PlanError::new_err(m),
+    }
+}
+
+fn parse(text: &str) -> PyResult<Problem> {
+    parse_problem(text).map_err(scene_error)
+}
+
+fn to_json(v: &Value) -> PyResult<String> {
+    serde_json::to_string(v).map_err(|e| PlanError::new_err(e.to_string()))
+}
+
+/// Validates an `edmp-scene/1` document (JSON text); raises `SceneError` naming the field.
+#[pyfunction]
+fn validate(scene: &str) -> PyResult<()> {
+    parse(scene).map(|_| ())
+}
+
+/// Plans with the shipped configuration and returns the `edmp-plan/1` document as JSON text;
+/// `timed` adds the `trajectory` field as `edmp-host plan --timed` does (free plans only).
+#[pyfunction]
+#[pyo3(signature = (scene, seed = 0, candidates = false, timed = false, rate = 100.0, velocity_scale = 1.0, acceleration_scale = 1.0))]
+#[allow(clippy::too_many_arguments)]
+fn plan(
+    py: Python<'_>,
+    scene: &str,
+    seed: u64,
+    candidates: bool,
+    timed: bool,
+    rate: f64,
+    velocity_scale: f32,
+    acceleration_scale: f32,
+) -> PyResult<String> {
+    let problem = parse(scene)?;
+    // Validated before planning, as the CLI does: a bad scale is a ValueError, nothing runs.
+    let request = if timed {
+        Some(
+            TimedRequest::new(rate, velocity_scale, acceleration_scale).map_err(|e| match e {
+                // The CLI names its flags; here they are keyword arguments.
+                Failure::Input(m) | Failure::NoPath(m) => PyValueError::new_err(
+                    m.replacen("--rate", "rate", 1)
+                        .replacen("--velocity-scale", "velocity_scale", 1)
+                        .replacen("--acceleration-scale", "acceleration_scale", 1),
+                ),
+            })?,
+        )
+    } else {
+        None
+    };
+    let doc = py.detach(move || -> Result<Value, Failure> {
+        let began = Instant::now();
+        let guides = chosen_guides(&[])?;
+        let config = PlanConfig::DEFAULT;
+        let planned = plan_problem(&problem, &guides, &config, seed)?;
+        let total_ms = began.elapsed().as_secs_f64() * 1e3;
+        let mut doc = plan_document(&problem, &planned, &guides, &config, seed, candidates, total_ms)?;
+        if let Some(request) = &request {
+            add_trajectory(&mut doc, &problem, &planned.plan, &config, request)?;
+        }
+        Ok(doc)
+    });
+    to_json(&doc.map_err(failure)?)
+}
+
+/// Milliseconds of `plan_problem` alone (parsing done, no JSON written), `repeats` times: the
+/// Rust side of `bench_overhead.py`.
+#[pyfunction]
+#[pyo3(signature = (scene, seed = 0, repeats = 10))]
+fn plan_problem_ms(py: Python<'_>, scene: &str, seed: u64, repeats: u32) -> PyResult<Vec<f64>> {
+    let problem = parse(scene)?;
+    py.detach(move || {
+        let guides = chosen_guides(&[])?;
+        (0..repeats)
+            .map(|_| {
+                let began = Instant::now();
+                plan_problem(&problem, &guides, &PlanConfig::DEFAULT, seed)?;
+                Ok(began.elapsed().as_secs_f64() * 1e3)
+            })
+            .collect::<Result<Vec<f64>, Failure>>()
+    })
+    .map_err(failure)
+}
+
+fn pose_json(p: &Pose<f32>) -> Value {
+    let t: [f32; 3] = p.translation.into();
+    json!({"position": t, "quaternion": p.quaternion_wxyz()})
+}
+
+fn joints_of(q: &[f64], what: &str) -> PyResult<[f32; JOINTS]> {
+    if q.len() != JOINTS {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected {JOINTS} joint angles, found {}",
+            q.len()
+        )));
+    }
+    let mut out = [0.0f32; JOINTS];
+    for (i, (slot, &x)) in out.iter_mut().zip(q).enumerate() {
+        if !x.is_finite() || x.abs() > f64::from(f32::MAX) {
+            return Err(PyValueError::new_err(format!(
+                "{what}[{i}] ({}): {x} is not a finite number",
+                JOINT_NAMES[i]
+            )));
+        }
+        *slot = x as f32;
+    }
+    Ok(out)
+}
+
+/// Forward kinematics as `edmp-host fk --json` prints it (JSON text): the TCP, every link
+/// frame and every collision box.
+#[pyfunction]
+fn fk(q: Vec<f64>) -> PyResult<String> {
+    let q = joints_of(&q, "q")?;
+    let k = forward(&q).map_err(|e| PyValueError::new_err(format!("q: {e}")))?;
+    let frames: Vec<Value> = FRAME_NAMES
+        .iter()
+        .zip(k.frames.iter())
+        .map(|(&name, p)| {
+            let mut v = pose_json(p);
+            v["name"] = json!(name);
+            v
+        })
+        .collect();
+    let boxes: Vec<Value> = BODY_NAMES
+        .iter()
+        .zip(k.boxes.iter())
+        .zip(PANDA.bodies.iter())
+        .map(|((&name, p), spec)| {
+            let mut v = pose_json(p);
+            v["name"] = json!(name);
+            let half: [f32; 3] = spec.half_extents.into();
+            v["half_extents"] = json!(half);
+            v
+        })
+        .collect();
+    to_json(&json!({
+        "joints": q,
+        "within_soft_limits": PANDA.within_soft_limits(&q, 0.0),
+        "tcp": pose_json(k.tcp()),
+        "frames": frames,
+        "collision_boxes": boxes,
+    }))
+}
+
+fn describe(contact: Contact) -> String {
+    let body = |b: u8| BODY_NAMES.get(usize::from(b)).copied().unwrap_or("held_object");
+    match contact {
+        Contact::Obstacle { body: b, obstacle } => format!("{} touches obstacles[{obstacle}]", body(b)),
+        Contact::SelfContact { first, second } => format!("{} touches {}", body(first), body(second)),
+    }
+}
+
+/// The exact checker (`checker::check_trajectory`, every contact counted) on `HORIZON`
+/// waypoints in the scene: a JSON report.
+#[pyfunction]
+fn check(scene: &str, waypoints: Vec<Vec<f64>>) -> PyResult<String> {
+    let problem = parse(scene)?;
+    if waypoints.len() != HORIZON {
+        return Err(PyValueError::new_err(format!(
+            "waypoints: expected {HORIZON} rows (the plan format's), found {}",
+            waypoints.len()
+        )));
+    }
+    let mut path = [[0.0f32; JOINTS]; HORIZON];
+    for (i, (slot, row)) in path.iter_mut().zip(&waypoints).enumerate() {
+        *slot = joints_of(row, &format!("waypoints[{i}]"))?;
+    }
+    let report = check_trajectory(&problem.scene, &path, &CheckConfig::default(), false)
+        .map_err(|e| PlanError::new_err(format!("checker: {e}")))?;
+    let first = report
+        .first_contact
+        .map(|c| json!({"segment": c.segment, "step": c.step, "contact": describe(c.contact)}));
+    to_json(&json!({
+        "free": report.is_free(),
+        "states": report.states,
+        "colliding_states": report.colliding_states,
+        "first_contact": first,
+    }))
+}
+
+/// The core IK as a pose goal uses it (`json::joint_goal`): the collision-free solution in the
+/// scene nearest its start, or `None` when none is found.
+#[pyfunction]
+fn ik(scene: &str, position: Vec<f64>, quaternion: Vec<f64>) -> PyResult<Option<Vec<f32>>> {
+    let problem = parse(scene)?;
+    let finite = |v: &[f64], n: usize, what: &str| -> PyResult<Vec<f32>> {
+        if v.len() != n || v.iter().any(|x| !x.is_finite()) {
+            return Err(PyValueError::new_err(format!("{what}: expected {n} finite numbers")));
+        }
+        Ok(v.iter().map(|&x| x as f32).collect())
+    };
+    let (p, q) = (finite(&position, 3, "position")?, finite(&quaternion, 4, "quaternion")?);
+    let norm = q.iter().map(|x| x * x).sum::<f32>().sqrt();
+    if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+        return Err(PyValueError::new_err(format!("quaternion: norm {norm:.2}, expected 1")));
+    }
+    let posed = Problem {
+        goal: Goal::Pose {
+            position: [p[0], p[1], p[2]],
+            quaternion: [q[0], q[1], q[2], q[3]],
+        },
+        ..problem
+    };
+    Ok(joint_goal(&posed).ok().map(|j| j.to_vec()))
+}
+
+/// A MoveIt planning scene (and motion plan request), YAML text, as `edmp-scene/1` JSON text,
+/// validated by the host's reader; raises `SceneError` naming the YAML or JSON path.
+#[pyfunction]
+#[pyo3(signature = (scene_yaml, request_yaml = None))]
+fn import_moveit(scene_yaml: &str, request_yaml: Option<&str>) -> PyResult<String> {
+    let (doc, _) = edmp_host::moveit::import_validated(scene_yaml, request_yaml).map_err(scene_error)?;
+    to_json(&doc)
+}
+
+/// The native half of `edmp` (use the `edmp` package).
+#[pymodule]
+mod _edmp {
+    #[pymodule_export]
+    use super::{PlanError, SceneError, check, fk, ik, import_moveit, plan, plan_problem_ms, validate};
+}

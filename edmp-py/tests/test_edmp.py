@@ -1,0 +1,216 @@
+"""The `edmp` package: plan, fk, check, ik, errors and MoveIt scenes, against the CLI where it
+is at hand (set EDMP_HOST to the edmp-host binary; scripts/test does)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import edmp
+
+ROOT = Path(__file__).resolve().parents[2]
+WALL = ROOT / "examples" / "wall.json"
+MOVEIT = ROOT / "edmp-host" / "tests" / "moveit"
+HOST = os.environ.get("EDMP_HOST")
+
+
+@pytest.fixture(scope="module")
+def wall() -> edmp.Scene:
+    return edmp.Scene.from_file(WALL)
+
+
+@pytest.fixture(scope="module")
+def wall_plan(wall: edmp.Scene) -> edmp.Plan:
+    return edmp.plan(wall, seed=0, candidates=True)
+
+
+def test_scene_constructors_agree(wall: edmp.Scene) -> None:
+    text = WALL.read_text()
+    for scene in (edmp.Scene.from_json(text), edmp.Scene.from_dict(json.loads(text))):
+        assert scene.to_dict() == wall.to_dict()
+    np.testing.assert_array_equal(wall.start, [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785])
+    assert isinstance(wall.goal, np.ndarray) and wall.goal.shape == (7,)
+    assert len(wall.obstacles) == 4 and wall.held_object is None
+    pose_scene = edmp.Scene.from_file(ROOT / "examples" / "tabletop-pose-held.json")
+    assert isinstance(pose_scene.goal, edmp.Pose) and pose_scene.goal.quaternion.shape == (4,)
+
+
+def test_the_wall_example_plans_collision_free(wall: edmp.Scene, wall_plan: edmp.Plan) -> None:
+    p = wall_plan
+    assert p.status == "success" and p.success
+    assert p.waypoints.shape == (50, 7) and p.waypoints.dtype == np.float64
+    np.testing.assert_allclose(p.waypoints[0], wall.start, atol=1e-6)
+    np.testing.assert_allclose(p.waypoints[-1], wall.goal, atol=1e-6)
+    assert p.stage in ("diffusion", "reseeded", "search")
+    assert set(p.costs) == {"swept_volume", "intersection_volume"}
+    assert p.timing_ms["total"] > 0
+    assert p.document["format"] == "edmp-plan/1"
+
+
+def test_a_seed_makes_the_plan_deterministic(wall: edmp.Scene, wall_plan: edmp.Plan) -> None:
+    again = edmp.plan(wall, seed=0, candidates=True)
+    np.testing.assert_array_equal(again.waypoints, wall_plan.waypoints)
+    assert again.guide == wall_plan.guide and again.costs == wall_plan.costs
+
+
+def test_candidates_are_the_ensemble(wall: edmp.Scene, wall_plan: edmp.Plan) -> None:
+    cands = wall_plan.candidates
+    assert cands is not None and len(cands) == 12
+    assert all(c.waypoints.shape == (50, 7) for c in cands)
+    assert any(np.array_equal(c.waypoints, wall_plan.waypoints) for c in cands)
+    assert edmp.plan(wall, seed=1).candidates is None
+
+
+def test_timed_plans_start_and_end_at_rest_within_the_limits(wall: edmp.Scene) -> None:
+    p = edmp.plan(wall, seed=0, timed=True, rate=200.0, velocity_scale=0.5)
+    t = p.trajectory
+    assert t is not None and t["joint_names"][0] == "panda_joint1"
+    n = len(t["time_from_start"])
+    assert t["positions"].shape == (n, 7) and n > 10
+    assert np.all(np.diff(t["time_from_start"]) > 0)
+    np.testing.assert_allclose(t["positions"][0], p.waypoints[0], atol=1e-6)
+    np.testing.assert_allclose(t["positions"][-1], p.waypoints[-1], atol=1e-6)
+    assert np.all(t["velocities"][[0, -1]] == 0.0)
+    limit = 0.5 * np.array([2.175] * 4 + [2.61] * 3)
+    assert np.all(np.abs(t["velocities"]) <= limit * (1 + 1e-4))
+    assert t["limits"]["velocity_scale"] == 0.5 and t["limits"]["jerk_limited"]
+    assert edmp.plan(wall, seed=0).trajectory is None
+
+
+def test_bad_timing_scales_are_value_errors(wall: edmp.Scene) -> None:
+    with pytest.raises(ValueError, match="velocity_scale: 1.5"):
+        edmp.plan(wall, timed=True, velocity_scale=1.5)
+    with pytest.raises(ValueError, match="rate"):
+        edmp.plan(wall, timed=True, rate=0.0)
+
+
+def test_planning_releases_the_gil(wall: edmp.Scene) -> None:
+    done = threading.Event()
+    ticks = 0
+
+    def run() -> None:
+        edmp.plan(wall, seed=2)
+        done.set()
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    time.sleep(0.01)
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0)
+    worker.join()
+    # With the GIL held through the plan (hundreds of ms), this thread could not run at all.
+    assert ticks > 100, ticks
+
+
+@pytest.mark.skipif(HOST is None, reason="EDMP_HOST (the edmp-host binary) not set")
+def test_a_plan_is_the_cli_document(wall_plan: edmp.Plan) -> None:
+    out = subprocess.run(
+        [HOST, "plan", str(WALL), "--seed", "0", "--candidates"], capture_output=True, text=True, check=True
+    )
+    cli = json.loads(out.stdout)
+    ours = dict(wall_plan.document)
+    for doc in (cli, ours):
+        doc.pop("timing_ms")
+    assert ours == cli
+
+
+def test_fk_of_the_ready_pose() -> None:
+    q = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]
+    r = edmp.fk(q)
+    np.testing.assert_allclose(r["tcp"]["position"], [0.307, 0.0, 0.4853], atol=1e-3)
+    assert abs(abs(r["tcp"]["quaternion"][1]) - 1.0) < 1e-3  # pointing down: 180° about x
+    assert len(r["frames"]) == 13 and len(r["collision_boxes"]) == 11
+    assert r["frames"][-1]["name"] == "panda_grasptarget"
+    np.testing.assert_allclose(r["frames"][-1]["position"], r["tcp"]["position"])
+    assert r["within_soft_limits"] is True
+    with pytest.raises(ValueError, match="expected shape"):
+        edmp.fk([0.0] * 6)
+
+
+@pytest.mark.skipif(HOST is None, reason="EDMP_HOST (the edmp-host binary) not set")
+def test_fk_is_what_the_cli_prints() -> None:
+    q = ["0.1", "-0.5", "0.2", "-2.0", "0.3", "1.8", "-0.4"]
+    out = subprocess.run([HOST, "fk", *q, "--json"], capture_output=True, text=True, check=True)
+    cli = json.loads(out.stdout)
+    ours = edmp.fk([float(x) for x in q])
+    assert cli["within_soft_limits"] == ours["within_soft_limits"]
+    for key in ("frames", "collision_boxes"):
+        for a, b in zip(cli[key], ours[key], strict=True):
+            assert a["name"] == b["name"]
+            np.testing.assert_array_equal(np.float32(a["position"]), np.float32(b["position"]))
+            np.testing.assert_array_equal(np.float32(a["quaternion"]), np.float32(b["quaternion"]))
+
+
+def test_check_tells_a_free_path_from_a_colliding_one(wall: edmp.Scene, wall_plan: edmp.Plan) -> None:
+    free = edmp.check(wall, wall_plan.waypoints)
+    assert free and free.colliding_states == 0 and free.first_contact is None and free.states >= 50
+    # Straight through joint space: joint 1 swings the arm from one side of the wall to the other.
+    straight = np.linspace(wall.start, wall.goal, 50)
+    hit = edmp.check(wall, straight)
+    assert not hit and hit.colliding_states > 0
+    assert "touches obstacles[1]" in hit.first_contact["contact"]  # the wall
+    with pytest.raises(ValueError, match="expected 50 rows"):
+        edmp.check(wall, straight[:10])
+
+
+def test_ik_reaches_a_pose_or_says_none(wall: edmp.Scene) -> None:
+    goal_tcp = edmp.fk(wall.goal)["tcp"]
+    q = edmp.ik(wall, goal_tcp["position"], goal_tcp["quaternion"])
+    assert q is not None and q.shape == (7,)
+    reached = edmp.fk(q)["tcp"]
+    np.testing.assert_allclose(reached["position"], goal_tcp["position"], atol=1e-3)
+    assert edmp.ik(wall, [2.0, 0.0, 0.5], [1.0, 0.0, 0.0, 0.0]) is None  # out of reach
+    with pytest.raises(ValueError, match="quaternion: norm"):
+        edmp.ik(wall, [0.5, 0.0, 0.5], [0.5, 0.0, 0.0, 0.0])
+
+
+def test_errors_name_the_json_path() -> None:
+    doc = json.loads(WALL.read_text())
+    doc["obstacles"][0]["quaternion"] = [0.71, 0, 0, 0]
+    with pytest.raises(edmp.SceneError) as e:
+        edmp.Scene.from_dict(doc)
+    assert str(e.value) == "obstacles[0].quaternion: norm 0.71, expected 1"
+    assert isinstance(e.value, ValueError)
+    doc = json.loads(WALL.read_text())
+    doc["start"] = [0.0, -0.785]
+    with pytest.raises(edmp.SceneError, match=r"^start: expected 7 numbers, found 2$"):
+        edmp.plan(doc)
+    with pytest.raises(edmp.SceneError, match="not valid JSON"):
+        edmp.Scene.from_json("{")
+
+
+def test_an_unreachable_pose_goal_is_a_plan_error(wall: edmp.Scene) -> None:
+    doc = wall.to_dict()
+    doc["goal"] = {"pose": {"position": [2.0, 0.0, 0.5], "quaternion": [1, 0, 0, 0]}}
+    scene = edmp.Scene.from_dict(doc)  # valid input ...
+    with pytest.raises(edmp.PlanError, match="goal.pose: unreachable"):
+        edmp.plan(scene)  # ... that no configuration reaches
+
+
+def test_moveit_scene_and_request_import_and_plan(wall: edmp.Scene) -> None:
+    scene = edmp.import_moveit(MOVEIT / "table_box.scene.yaml", MOVEIT / "joint_goal.request.yaml")
+    assert [o["type"] for o in scene.obstacles] == [o["type"] for o in wall.obstacles]
+    np.testing.assert_array_equal(scene.start, wall.start)
+    np.testing.assert_array_equal(scene.goal, wall.goal)
+    assert scene.to_dict()["meta"]["object_ids"] == ["table", "wall", "can", "ball"]
+    assert edmp.plan(scene, seed=0).success
+    posed = edmp.import_moveit(
+        (MOVEIT / "table_box.scene.yaml").read_text(), (MOVEIT / "pose_goal.request.yaml").read_text()
+    )
+    assert isinstance(posed.goal, edmp.Pose)
+    np.testing.assert_allclose(posed.goal.position, [0.48748365, -0.3335055, 0.25502735], atol=1e-6)
+    alone = edmp.import_moveit(MOVEIT / "table_box.scene.yaml")
+    np.testing.assert_array_equal(alone.goal, alone.start)
+
+
+def test_moveit_meshes_are_an_error_naming_the_yaml_path() -> None:
+    with pytest.raises(edmp.SceneError, match=r"world\.collision_objects\[1\]\.meshes: not supported"):
+        edmp.import_moveit(MOVEIT / "mesh.scene.yaml")
