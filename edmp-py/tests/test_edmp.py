@@ -214,3 +214,21 @@ def test_moveit_scene_and_request_import_and_plan(wall: edmp.Scene) -> None:
 def test_moveit_meshes_are_an_error_naming_the_yaml_path() -> None:
     with pytest.raises(edmp.SceneError, match=r"world\.collision_objects\[1\]\.meshes: not supported"):
         edmp.import_moveit(MOVEIT / "mesh.scene.yaml")
+
+
+def test_the_gripper_opening_is_part_of_the_problem() -> None:
+    # Fingers open to 0.04 m around a can: the grasp plans; at the default 0.025 m the open
+    # grasp pose puts a finger into the can, so no collision-free IK goal exists.
+    grasp = json.loads((ROOT / "examples" / "grasp-can.json").read_text())
+    p = edmp.plan(edmp.Scene.from_dict(grasp), seed=0)
+    assert p.status == "success"
+    q = p.waypoints[-1]
+    assert edmp.check(edmp.Scene.from_dict({**grasp, "goal": {"joints": q.tolist()}}), p.waypoints)
+    closed = {k: v for k, v in grasp.items() if k != "gripper"}
+    # The same joint goal with the fingers at 0.025 m touches the can: refused as input.
+    with pytest.raises(edmp.SceneError, match="collision"):
+        edmp.Scene.from_dict({**closed, "goal": {"joints": q.tolist()}})
+    with pytest.raises(edmp.PlanError, match="unreachable"):
+        edmp.plan(edmp.Scene.from_dict(closed), seed=0)
+    with pytest.raises(edmp.SceneError, match=r"gripper\.finger"):
+        edmp.Scene.from_dict({**grasp, "gripper": {"finger": 0.05}})
