@@ -31,5 +31,5 @@ python3 benchmarks/check_timed.py $timed > "$out/check_timed.txt" || { tail -n 2
 tail -n 1 "$out/check_timed.txt"
 venv=${TOPPRA_VENV:-/tmp/toppra-venv}
 [ -x "$venv/bin/python" ] || { python3 -m venv "$venv" && "$venv/bin/pip" install -q -r benchmarks/requirements-toppra.txt; }
-"$venv/bin/python" benchmarks/toppra_compare.py $(ls "$out"/*.timed.json) > "$out/toppra.txt"
+"$venv/bin/python" benchmarks/toppra_compare.py $(printf '%s\n' $timed | grep '\.timed\.json$') > "$out/toppra.txt"
 tail -n 4 "$out/toppra.txt"
