@@ -279,6 +279,9 @@ fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene {
     if let Some(held) = doc.get("held_object") {
         scene.hold(primitive(held));
     }
+    if let Some(w) = doc.get("gripper").map(|g| g["finger"].as_f64().unwrap() as f32) {
+        scene = scene.with_gripper(w).unwrap();
+    }
     scene
 }
 
