@@ -65,8 +65,8 @@ pub struct ShortcutReport {
     pub length_before: f32,
     /// Joint-space length after (equal to `length_before` when nothing passed the checker).
     pub length_after: f32,
-    /// Shortcuts that joined two waypoints.
-    pub corners: u8,
+    /// Waypoints the shortcuts dropped (50 minus the shortened polyline's vertices).
+    pub dropped: u8,
     /// Laplacian passes kept.
     pub smoothing: u8,
 }
@@ -88,7 +88,7 @@ pub fn shorten<const N: usize>(
     let mut report = ShortcutReport {
         length_before,
         length_after: length_before,
-        corners: 0,
+        dropped: 0,
         smoothing: 0,
     };
     let free = |p: &Path| -> Result<bool, Error> { Ok(check_trajectory(scene, p, check, true)?.is_free()) };
@@ -117,7 +117,7 @@ pub fn shorten<const N: usize>(
             return Ok(report);
         };
         *path = candidate;
-        report.corners = u8::try_from(HORIZON.saturating_sub(n)).unwrap_or(u8::MAX);
+        report.dropped = u8::try_from(HORIZON.saturating_sub(n)).unwrap_or(u8::MAX);
     }
     for _ in 0..config.smoothing {
         let smoothed = laplacian(path);

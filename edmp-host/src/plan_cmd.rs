@@ -335,7 +335,7 @@ pub fn plan_document(
         "shortcut": plan.shortcut.map(|s| json!({
             "length_before": s.length_before,
             "length_after": s.length_after,
-            "corners": s.corners,
+            "dropped": s.dropped,
             "smoothing": s.smoothing,
         })),
         "costs": {"swept_volume": plan.verdicts[plan.best].swept, "intersection_volume": intersection},
