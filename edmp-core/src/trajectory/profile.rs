@@ -67,13 +67,17 @@ impl Profile<'_> {
 
     /// The raw profile at `τ`: (u, u̇, ü).
     pub(crate) fn raw(&self, tau: f32) -> (f32, f32, f32) {
+        self.raw_in(tau, self.interval(tau))
+    }
+
+    /// [`Profile::raw`] with `τ`'s interval `i` already found (used only when `τ` is inside).
+    fn raw_in(&self, tau: f32, i: usize) -> (f32, f32, f32) {
         if tau.is_nan() || tau <= 0.0 || self.intervals() == 0 {
             return (0.0, 0.0, 0.0);
         }
         if tau >= self.end() {
             return (self.last_u(), 0.0, 0.0);
         }
-        let i = self.interval(tau);
         let (t0, u0, v0, a) = self.piece(i);
         let s = (tau - t0).max(0.0);
         let u1 = (i + 1) as f32 / self.m;
@@ -81,67 +85,56 @@ impl Profile<'_> {
         (u, (v0 + a * s).max(0.0), a)
     }
 
-    /// `∫_{lo}^{hi} (u(τ) − c) dτ` over the raw profile, piece by piece (no cancellation of
-    /// large values: each piece integrates its own offset from `c`).
-    fn integral(&self, lo: f32, hi: f32, c: f32) -> f32 {
+    /// Over the raw profile, in one pass piece by piece: `∫_{lo}^{hi} (u(τ) − c) dτ` (no
+    /// cancellation of large values: each piece integrates its own offset from `c`) and
+    /// `u(hi) − u(lo)` (summed, because the difference of two nearby values of `u` (up to 150
+    /// spans) would lose `f32` digits that `u̇_f = (u(τ) − u(τ−w))/w` amplifies by `1/w`).
+    /// `first` and `last` are the intervals holding `max(lo, 0)` and `min(hi, end)`.
+    fn window(&self, lo: f32, hi: f32, c: f32, first: usize, last_interval: usize) -> (f32, f32) {
         let (end, last) = (self.end(), self.last_u());
-        let mut sum = 0.0f32;
+        let (mut integral, mut increment) = (0.0f32, 0.0f32);
         if lo < 0.0 {
-            sum += -c * (hi.min(0.0) - lo);
+            integral += -c * (hi.min(0.0) - lo);
         }
         if hi > end {
-            sum += (last - c) * (hi - lo.max(end));
+            integral += (last - c) * (hi - lo.max(end));
         }
         let (a, b) = (lo.max(0.0), hi.min(end));
         if b > a {
-            let (first, final_) = (self.interval(a), self.interval(b));
-            for i in first..=final_ {
+            for i in first..=last_interval {
                 let (t0, u0, v0, acc) = self.piece(i);
                 let t1 = self.t.get(i + 1).copied().unwrap_or(t0);
                 let s0 = a.max(t0) - t0;
                 let s1 = b.min(t1) - t0;
                 if s1 > s0 {
                     let (q0, q1) = (s0 * s0, s1 * s1);
-                    sum += (u0 - c) * (s1 - s0) + 0.5 * v0 * (q1 - q0) + acc / 6.0 * (q1 * s1 - q0 * s0);
+                    integral += (u0 - c) * (s1 - s0) + 0.5 * v0 * (q1 - q0) + acc / 6.0 * (q1 * s1 - q0 * s0);
+                    increment += v0 * (s1 - s0) + 0.5 * acc * (s1 * s1 - s0 * s0);
                 }
             }
         }
-        sum
-    }
-
-    /// `u(hi) − u(lo)` summed piece by piece: the difference of two nearby values of `u` (up
-    /// to 150 spans) would lose `f32` digits that `u̇_f = (u(τ) − u(τ−w))/w` amplifies by `1/w`.
-    fn increment(&self, lo: f32, hi: f32) -> f32 {
-        let (a, b) = (lo.max(0.0), hi.min(self.end()));
-        let mut sum = 0.0f32;
-        if b > a {
-            for i in self.interval(a)..=self.interval(b) {
-                let (t0, _, v0, acc) = self.piece(i);
-                let t1 = self.t.get(i + 1).copied().unwrap_or(t0);
-                let s0 = a.max(t0) - t0;
-                let s1 = b.min(t1) - t0;
-                if s1 > s0 {
-                    sum += v0 * (s1 - s0) + 0.5 * acc * (s1 * s1 - s0 * s0);
-                }
-            }
-        }
-        sum
+        (integral, increment)
     }
 
     /// The time law at `τ ∈ [0, duration]` (filtered when `w > 0`; jerk 0 without the filter).
     pub(crate) fn law(&self, tau: f32) -> Law {
         let tau = if tau > 0.0 { tau.min(self.duration()) } else { 0.0 };
-        let (u, v, a) = self.raw(tau);
         if self.w.is_nan() || self.w <= 0.0 {
+            let (u, v, a) = self.raw(tau);
             return Law { u, v, a, j: 0.0 };
         }
-        let (ub, vb, ab) = self.raw(tau - self.w);
+        // Two interval searches serve both ends of the window and the sums between them.
+        let (lo, end) = (tau - self.w, self.end());
+        let (first, last) = (self.interval(lo.max(0.0)), self.interval(tau.min(end)));
+        let (u, v, a) = self.raw_in(tau, last);
+        let (ub, vb, ab) = self.raw_in(lo, first);
         let inv = 1.0 / self.w;
-        let mean = ub + self.integral(tau - self.w, tau, ub) * inv;
+        let (integral, increment) = self.window(lo, tau, ub, first, last);
+        let mean = ub + integral * inv;
         Law {
             // max/min, not clamp: clamp panics when its bounds cross (a NaN, or rounding).
             u: mean.max(ub).min(u),
-            v: (self.increment(tau - self.w, tau) * inv).max(0.0),
+            v: (increment * inv).max(0.0),
             a: (v - vb) * inv,
             j: (a - ab) * inv,
         }
