@@ -660,7 +660,8 @@ fn distance2(a: &Joints<f32>, b: &Joints<f32>) -> f32 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
-fn segment_length(w: &[Joints<f32>]) -> f32 {
+/// Euclidean length of a two-point window (0 for any other length).
+pub(crate) fn segment_length(w: &[Joints<f32>]) -> f32 {
     match w {
         [a, b] => libm::sqrtf(distance2(a, b)),
         _ => 0.0,

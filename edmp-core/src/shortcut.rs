@@ -28,7 +28,7 @@ use crate::kinematics::Joints;
 use crate::prior::{HORIZON, Path};
 use crate::rng::Rng;
 use crate::scene::Scene;
-use crate::search::{resample_even, resample_through_vertices, shortcut_polyline};
+use crate::search::{resample_even, resample_through_vertices, segment_length, shortcut_polyline};
 
 /// How hard [`shorten`] tries.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -185,12 +185,7 @@ fn laplacian(path: &Path) -> Path {
 
 /// Joint-space length: the sum of the Euclidean steps.
 fn length(path: &Path) -> f32 {
-    path.windows(2)
-        .map(|w| match w {
-            [a, b] => libm::sqrtf(a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()),
-            _ => 0.0,
-        })
-        .sum()
+    path.windows(2).map(segment_length).sum()
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! `edmp-host fk`: print the pose of every link frame and collision box for one configuration.
 
-use edmp_core::kinematics::{Pose, forward};
+use edmp_core::Error;
+use edmp_core::kinematics::{Joints, Pose, forward};
 use edmp_core::robot::{BODY_NAMES, FRAME_NAMES, JOINT_NAMES, JOINTS, PANDA, TCP_FRAME};
 use serde::Serialize;
 
@@ -66,8 +67,27 @@ pub fn run(args: &Args) -> Result<(), String> {
         }
         *slot = value as f32;
     }
-    let k = forward(&q).map_err(|e| format!("joints: {e}"))?;
-    let report = Report {
+    let report = report(&q).map_err(|e| format!("joints: {e}"))?;
+    if args.json {
+        let text = serde_json::to_string_pretty(&report).map_err(|e| format!("cannot write JSON: {e}"))?;
+        println!("{text}");
+        return Ok(());
+    }
+    print_table(&report);
+    Ok(())
+}
+
+/// The `--json` document for `q` (what `edmp-host fk --json` prints): the one writer of it,
+/// which the Python package's `fk` shares.
+pub fn document(q: &Joints<f32>) -> Result<serde_json::Value, Error> {
+    let report = report(q)?;
+    Ok(serde_json::to_value(&report).unwrap_or(serde_json::Value::Null))
+}
+
+fn report(q: &Joints<f32>) -> Result<Report, Error> {
+    let q = *q;
+    let k = forward(&q)?;
+    Ok(Report {
         joints: q,
         within_soft_limits: PANDA.within_soft_limits(&q, 0.0),
         tcp: k.tcp().into(),
@@ -86,14 +106,7 @@ pub fn run(args: &Args) -> Result<(), String> {
                 half_extents: spec.half_extents.into(),
             })
             .collect(),
-    };
-    if args.json {
-        let text = serde_json::to_string_pretty(&report).map_err(|e| format!("cannot write JSON: {e}"))?;
-        println!("{text}");
-        return Ok(());
-    }
-    print_table(&report);
-    Ok(())
+    })
 }
 
 fn print_table(r: &Report) {

@@ -6,10 +6,9 @@
 //! from Python is the CLI's document. Planning releases the GIL.
 
 use edmp_core::checker::{CheckConfig, Contact, check_trajectory};
-use edmp_core::kinematics::{Pose, forward};
 use edmp_core::planner::PlanConfig;
 use edmp_core::prior::HORIZON;
-use edmp_core::robot::{BODY_NAMES, FRAME_NAMES, JOINT_NAMES, JOINTS, PANDA};
+use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS};
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;
 use edmp_host::json::{Goal, Problem, joint_goal, parse_problem};
@@ -123,11 +122,6 @@ fn plan_problem_ms(py: Python<'_>, scene: &str, seed: u64, repeats: u32) -> PyRe
     .map_err(failure)
 }
 
-fn pose_json(p: &Pose<f32>) -> Value {
-    let t: [f32; 3] = p.translation.into();
-    json!({"position": t, "quaternion": p.quaternion_wxyz()})
-}
-
 fn joints_of(q: &[f64], what: &str) -> PyResult<[f32; JOINTS]> {
     if q.len() != JOINTS {
         return Err(PyValueError::new_err(format!(
@@ -153,35 +147,8 @@ fn joints_of(q: &[f64], what: &str) -> PyResult<[f32; JOINTS]> {
 #[pyfunction]
 fn fk(q: Vec<f64>) -> PyResult<String> {
     let q = joints_of(&q, "q")?;
-    let k = forward(&q).map_err(|e| PyValueError::new_err(format!("q: {e}")))?;
-    let frames: Vec<Value> = FRAME_NAMES
-        .iter()
-        .zip(k.frames.iter())
-        .map(|(&name, p)| {
-            let mut v = pose_json(p);
-            v["name"] = json!(name);
-            v
-        })
-        .collect();
-    let boxes: Vec<Value> = BODY_NAMES
-        .iter()
-        .zip(k.boxes.iter())
-        .zip(PANDA.bodies.iter())
-        .map(|((&name, p), spec)| {
-            let mut v = pose_json(p);
-            v["name"] = json!(name);
-            let half: [f32; 3] = spec.half_extents.into();
-            v["half_extents"] = json!(half);
-            v
-        })
-        .collect();
-    to_json(&json!({
-        "joints": q,
-        "within_soft_limits": PANDA.within_soft_limits(&q, 0.0),
-        "tcp": pose_json(k.tcp()),
-        "frames": frames,
-        "collision_boxes": boxes,
-    }))
+    let doc = edmp_host::fk::document(&q).map_err(|e| PyValueError::new_err(format!("q: {e}")))?;
+    to_json(&doc)
 }
 
 fn describe(contact: Contact) -> String {
