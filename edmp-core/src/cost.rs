@@ -19,8 +19,8 @@
 
 use crate::error::Error;
 use crate::geometry::{Aabb, BoxFrame, CylinderBox, Inflation, box_dims, inflated_dims, obstacle_aabb};
-use crate::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward_with};
-use crate::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
+use crate::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward_into};
+use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Obstacle, Scene};
 use nalgebra::{Matrix3, Vector3};
 
@@ -205,7 +205,8 @@ fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector
 }
 
 /// One waypoint on its way through the cost: its kinematics and boxes, and the gradient its
-/// boxes' corners have collected so far (world vectors; `touched` once anything was added).
+/// boxes' corners have collected so far. Filled in place ([`Waypoint::place`]): the struct is a
+/// few kilobytes and the costs' inner loop must not copy it.
 #[derive(Clone, Copy, Debug)]
 struct Waypoint {
     k: Kinematics<f32>,
@@ -213,13 +214,42 @@ struct Waypoint {
     /// Per box, a world AABB holding its AABB in any frame, and their union (broad phase).
     balls: [Aabb; SLOTS],
     hull: Aabb,
-    pull: [[Vector3<f32>; CORNERS]; SLOTS],
+    pulls: Pulls,
+}
+
+/// The gradient on each box's corners (world vectors; `touched` once anything was added).
+#[derive(Clone, Copy, Debug)]
+struct Pulls {
+    corners: [[Vector3<f32>; CORNERS]; SLOTS],
     touched: bool,
 }
 
+const NO_BOX: Aabb = Aabb {
+    min: Vector3::new(0.0, 0.0, 0.0),
+    max: Vector3::new(0.0, 0.0, 0.0),
+};
+
 impl Waypoint {
-    fn new(k: Kinematics<f32>, held: Option<(&Pose<f32>, Vector3<f32>)>) -> Self {
-        let mut boxes = [IDLE; SLOTS];
+    const EMPTY: Self = Self {
+        k: Kinematics {
+            frames: [IDLE.pose; FRAMES],
+            boxes: [IDLE.pose; BODIES],
+        },
+        boxes: [IDLE; SLOTS],
+        balls: [NO_BOX; SLOTS],
+        hull: NO_BOX,
+        pulls: Pulls {
+            corners: [[Vector3::new(0.0, 0.0, 0.0); CORNERS]; SLOTS],
+            touched: false,
+        },
+    };
+
+    /// Places the boxes of the kinematics in `self.k` (and the held object's) and clears the
+    /// gradient.
+    fn place(&mut self, held: Option<(&Pose<f32>, Vector3<f32>)>) {
+        let k = &self.k;
+        let boxes = &mut self.boxes;
+        *boxes = [IDLE; SLOTS];
         for (b, slot) in boxes.iter_mut().enumerate().take(BODIES) {
             // Bodies on the fixed root (link0) never move and are not checked against obstacles.
             if PANDA.bodies[b].frame != 0 {
@@ -235,11 +265,8 @@ impl Waypoint {
             boxes[HELD] = RobotBox::new(pose, half);
         }
         let mut hull: Option<Aabb> = None;
-        let mut balls = [Aabb {
-            min: Vector3::zeros(),
-            max: Vector3::zeros(),
-        }; SLOTS];
-        for (b, ball) in boxes.iter().zip(balls.iter_mut()).filter(|(b, _)| b.active) {
+        self.balls = [NO_BOX; SLOTS];
+        for (b, ball) in boxes.iter().zip(self.balls.iter_mut()).filter(|(b, _)| b.active) {
             // Each AABB of the box lies in a cube of half side `radius` in its frame, so in a
             // ball of radius √3·radius.
             let r = Vector3::repeat(1.732_051 * b.radius);
@@ -249,24 +276,20 @@ impl Waypoint {
             };
             hull = Some(hull.map_or(*ball, |h| h.union(ball)));
         }
-        Self {
-            k,
-            boxes,
-            balls,
-            hull: hull.unwrap_or(Aabb {
-                min: Vector3::zeros(),
-                max: Vector3::zeros(),
-            }),
-            pull: [[Vector3::zeros(); CORNERS]; SLOTS],
+        self.hull = hull.unwrap_or(NO_BOX);
+        self.pulls = Pulls {
+            corners: [[Vector3::zeros(); CORNERS]; SLOTS],
             touched: false,
-        }
+        };
     }
+}
 
+impl Pulls {
     /// Adds the gradient on one bound (axis `k` of the obstacle's frame) to the corner that set it.
-    fn pull_bound(&mut self, slot: usize, corner: u8, o: &ObstacleBox, k: usize, g: f32) {
+    fn add(&mut self, slot: usize, corner: u8, o: &ObstacleBox, k: usize, g: f32) {
         self.touched = true;
         if g != 0.0 {
-            self.pull[slot % SLOTS][usize::from(corner) % CORNERS] += o.axis(k) * g;
+            self.corners[slot % SLOTS][usize::from(corner) % CORNERS] += o.axis(k) * g;
         }
     }
 }
@@ -318,21 +341,26 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
 
     let mut gradient = gradient;
     let mut total = 0.0f32;
-    let mut previous: Option<Waypoint> = None;
+    // Two waypoints in flight, swapped by reference: `before` is waypoint w − 1.
+    let mut pair = [Waypoint::EMPTY; 2];
+    let [before, current] = &mut pair;
+    let (mut before, mut current) = (before, current);
     for (w, q) in trajectory.iter().enumerate() {
         // The scene's finger opening places the finger boxes; for the adjoint it is a constant.
-        let mut current = Waypoint::new(forward_with(q, scene.gripper())?, held);
-        match (config.kind, previous.as_mut()) {
-            (CostKind::Intersection, _) if w > 0 && w + 1 < H => total += intersection(&mut current, obstacles),
-            (CostKind::Swept, Some(before)) => total += swept(before, &mut current, obstacles),
+        forward_into(q, scene.gripper(), &mut current.k)?;
+        current.place(held);
+        match config.kind {
+            CostKind::Intersection if w > 0 && w + 1 < H => total += intersection(current, obstacles),
+            CostKind::Swept if w > 0 => total += swept(before, current, obstacles),
             _ => {}
         }
-        if let Some(done) = previous.replace(current) {
-            finish(&done, w - 1, gradient.as_deref_mut())?;
+        if w > 0 {
+            finish(before, w - 1, gradient.as_deref_mut())?;
         }
+        core::mem::swap(&mut before, &mut current);
     }
-    if let Some(done) = previous {
-        finish(&done, H - 1, gradient)?;
+    if H > 0 {
+        finish(before, H - 1, gradient)?;
     }
     if total.is_finite() {
         Ok(total)
@@ -346,7 +374,7 @@ fn finish<const H: usize>(done: &Waypoint, w: usize, gradient: Option<&mut [Join
     let Some(slot) = gradient.and_then(|g| g.get_mut(w)) else {
         return Ok(());
     };
-    *slot = if done.touched {
+    *slot = if done.pulls.touched {
         // Finite inputs whose volumes' gradients overflowed are an overflow, not bad input.
         waypoint_gradient(done).map_err(|e| match e {
             Error::NonFiniteGradient => Error::Overflow,
@@ -367,11 +395,16 @@ fn overlaps(a: &Aabb, b: &Aabb) -> bool {
 /// Intersection volume of one interior waypoint's boxes; adds its gradient to the waypoint.
 fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     let mut total = 0.0;
-    let hull = w.hull;
-    for o in obstacles.iter().filter(|o| overlaps(&hull, &o.world)) {
-        for s in 0..SLOTS {
-            let b = w.boxes[s];
-            if !b.active || !overlaps(&w.balls[s], &o.world) {
+    let Waypoint {
+        boxes,
+        balls,
+        hull,
+        pulls,
+        ..
+    } = w;
+    for o in obstacles.iter().filter(|o| overlaps(hull, &o.world)) {
+        for (s, (b, ball)) in boxes.iter().zip(balls.iter()).enumerate() {
+            if !b.active || !overlaps(ball, &o.world) {
                 continue;
             }
             let c = o.local(&b.pose.translation);
@@ -382,8 +415,8 @@ fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
             if let Some((v, d_min, d_max)) = volume_with_gradient(&aabb, &o.bounds) {
                 total += v;
                 for k in 0..3 {
-                    w.pull_bound(s, arg[0][k], o, k, d_min[k]);
-                    w.pull_bound(s, arg[1][k], o, k, d_max[k]);
+                    pulls.add(s, arg[0][k], o, k, d_min[k]);
+                    pulls.add(s, arg[1][k], o, k, d_max[k]);
                 }
             }
         }
@@ -419,7 +452,7 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     let Some(hull) = hull else {
         return 0.0;
     };
-    let (boxes_a, boxes_b) = (a.boxes, b.boxes);
+    let (boxes_a, pulls_a, boxes_b, pulls_b) = (&a.boxes, &mut a.pulls, &b.boxes, &mut b.pulls);
     for o in obstacles.iter().filter(|o| overlaps(&hull, &o.world)) {
         let ends = boxes_a.iter().zip(boxes_b.iter());
         for (s, ((box_a, box_b), r)) in ends.zip(reach.iter()).enumerate() {
@@ -440,14 +473,14 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
                 total += v;
                 for k in 0..3 {
                     if lb.min[k] < la.min[k] {
-                        b.pull_bound(s, arg_b[0][k], o, k, d_min[k]);
+                        pulls_b.add(s, arg_b[0][k], o, k, d_min[k]);
                     } else {
-                        a.pull_bound(s, arg_a[0][k], o, k, d_min[k]);
+                        pulls_a.add(s, arg_a[0][k], o, k, d_min[k]);
                     }
                     if lb.max[k] > la.max[k] {
-                        b.pull_bound(s, arg_b[1][k], o, k, d_max[k]);
+                        pulls_b.add(s, arg_b[1][k], o, k, d_max[k]);
                     } else {
-                        a.pull_bound(s, arg_a[1][k], o, k, d_max[k]);
+                        pulls_a.add(s, arg_a[1][k], o, k, d_max[k]);
                     }
                 }
             }
@@ -461,7 +494,7 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
 /// takes it to the joints.
 fn waypoint_gradient(w: &Waypoint) -> Result<Joints<f32>, Error> {
     let mut cot = Cotangent::new();
-    for (s, (pulls, b)) in w.pull.iter().zip(w.boxes.iter()).enumerate() {
+    for (s, (pulls, b)) in w.pulls.corners.iter().zip(w.boxes.iter()).enumerate() {
         if !b.active {
             continue;
         }

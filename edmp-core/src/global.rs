@@ -18,7 +18,7 @@ use crate::checker::check_segment;
 use crate::error::Error;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::planner::{Plan, PlanConfig, Workspace, guide_batch, judge, rank_in_full, select};
+use crate::planner::{Plan, PlanConfig, Workspace, guide_steps, judge, rank_in_full, select};
 use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise};
 use crate::rng::Rng;
 use crate::scene::Scene;
@@ -140,8 +140,9 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
         prior::diffuse(x, global.noise_step, rng, start, goal);
     }
     let strided = Sampler::Strided { steps: global.steps };
-    let guide =
-        |paths: &mut [Path; B], grads: &mut [Path; B], t: u16| guide_batch(scene, paths, grads, guides, t, config);
+    let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16, steps: u8| {
+        guide_steps(scene, paths, grads, guides, t, steps, config)
+    };
     for j in 0..usize::from(global.steps) {
         let step = Step::partial(global.noise_step, global.steps, j);
         predict_noise(&plan.paths, &TimeEmbedding::new(step.t)?, scratch, &mut work.eps)?;
@@ -149,14 +150,10 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
             strided.update(step, x, e, rng, start, goal);
         }
         if step.t >= 5 {
-            for _ in 0..global.per_step {
-                guide(&mut plan.paths, &mut work.grads, step.t)?;
-            }
+            guide(&mut plan.paths, &mut work.grads, step.t, global.per_step)?;
         }
     }
-    for _ in 0..global.refine {
-        guide(&mut plan.paths, &mut work.grads, 1)?;
-    }
+    guide(&mut plan.paths, &mut work.grads, 1, global.refine)?;
     judge(scene, start, goal, config, plan)?;
     plan.search = Some(searched);
     if plan.is_free() {

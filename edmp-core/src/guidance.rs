@@ -22,6 +22,12 @@ use crate::scene::Scene;
 /// things ([`CostConfig`]). Fails with [`Error::BadParameter`] if the rows do not split evenly over the guides or
 /// `grads` has another length; non-finite joints and overflowing results are typed errors too,
 /// and then `rows` may be partly updated.
+///
+/// `settled` is empty (every guide steps) or holds one flag per guide: a guide whose flag is set
+/// is skipped, and a guide none of whose rows changed a bit in this step gets its flag set. At
+/// a fixed `t` a guide's step depends only on its rows, so the next step of a settled guide would
+/// be the same no-op: skipping it saves the work and changes no bit. Clear the flags whenever
+/// `t` (or the scene) changes. Any other length is [`Error::BadParameter`].
 #[allow(clippy::too_many_arguments)]
 pub fn guide_step<const H: usize, const N: usize>(
     scene: &Scene<N>,
@@ -32,6 +38,7 @@ pub fn guide_step<const H: usize, const N: usize>(
     step_limit: f32,
     cylinder: CylinderBox,
     frame: BoxFrame,
+    settled: &mut [bool],
 ) -> Result<(), Error> {
     if step_limit.is_nan() || step_limit <= 0.0 {
         return Err(Error::BadParameter);
@@ -39,15 +46,22 @@ pub fn guide_step<const H: usize, const N: usize>(
     if guides.is_empty() || !rows.len().is_multiple_of(guides.len()) || grads.len() != rows.len() || H < 3 {
         return Err(Error::BadParameter);
     }
+    if !settled.is_empty() && settled.len() != guides.len() {
+        return Err(Error::BadParameter);
+    }
     let per_guide = rows.len() / guides.len();
     if per_guide == 0 {
         return Ok(());
     }
-    for ((guide, rows), grads) in guides
+    for (g, ((guide, rows), grads)) in guides
         .iter()
         .zip(rows.chunks_mut(per_guide))
         .zip(grads.chunks_mut(per_guide))
+        .enumerate()
     {
+        if settled.get(g).copied().unwrap_or(false) {
+            continue;
+        }
         let config = CostConfig {
             kind: guide.cost,
             inflation: guide.inflation(t),
@@ -66,19 +80,28 @@ pub fn guide_step<const H: usize, const N: usize>(
         } else if norm2 > 0.0 && norm2.is_finite() {
             step / libm::sqrtf(norm2)
         } else if norm2 == 0.0 {
+            if let Some(flag) = settled.get_mut(g) {
+                *flag = true;
+            }
             continue;
         } else {
             return Err(Error::Overflow);
         };
+        let mut moved = false;
         for (row, grad) in rows.iter_mut().zip(grads.iter()) {
-            for (q, g) in row[1..H - 1].iter_mut().zip(&grad[1..H - 1]) {
-                for (qj, gj) in q.iter_mut().zip(g) {
-                    *qj -= (scale * gj).clamp(-step_limit, step_limit);
+            for (q, gq) in row[1..H - 1].iter_mut().zip(&grad[1..H - 1]) {
+                for (qj, gj) in q.iter_mut().zip(gq) {
+                    let next = *qj - (scale * gj).clamp(-step_limit, step_limit);
+                    moved |= next.to_bits() != qj.to_bits();
+                    *qj = next;
                 }
             }
             if row.iter().flatten().any(|v| !v.is_finite()) {
                 return Err(Error::Overflow);
             }
+        }
+        if let Some(flag) = settled.get_mut(g) {
+            *flag = !moved;
         }
     }
     Ok(())
@@ -144,6 +167,7 @@ mod tests {
                 f32::INFINITY,
                 CylinderBox::Enclosing,
                 BoxFrame::Obstacle,
+                &mut [],
             )
             .unwrap();
             let after = cost(&scene, &rows[0], guide, t);
@@ -171,6 +195,7 @@ mod tests {
             f32::INFINITY,
             CylinderBox::Enclosing,
             BoxFrame::Obstacle,
+            &mut [],
         )
         .unwrap();
         assert_eq!(rows, before);
@@ -210,6 +235,7 @@ mod tests {
             f32::INFINITY,
             CylinderBox::Enclosing,
             BoxFrame::Obstacle,
+            &mut [],
         )
         .unwrap();
         guide_step(
@@ -221,6 +247,7 @@ mod tests {
             f32::INFINITY,
             CylinderBox::Enclosing,
             BoxFrame::Obstacle,
+            &mut [],
         )
         .unwrap();
         assert_eq!(g1, g2);
@@ -230,6 +257,68 @@ mod tests {
         );
         // Applied to the unclipped state.
         assert!((r1[0][5][6] - (10.0 - (clipped[5][6] - r2[0][5][6]))).abs() < 1e-5);
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "guidance steps over a batch: too slow under Miri")]
+    fn settled_guides_are_skipped_without_changing_a_bit() {
+        // Two guides: one row through the wall (keeps moving), one far from it (settles at once).
+        let scene = scene();
+        let through = line(
+            [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8],
+            [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8],
+        );
+        let away = line(
+            [2.0, -1.0, 0.0, -2.5, 0.0, 1.5, 0.8],
+            [2.5, -1.0, 0.0, -2.5, 0.0, 1.5, 0.8],
+        );
+        let guides = [EDMP_GUIDES[0], EDMP_GUIDES[5]];
+        let run = |tracked: bool| {
+            let mut rows = [through, away];
+            let mut grads = [[[0.0; 7]; H]; 2];
+            let mut settled = [false; 2];
+            for _ in 0..6 {
+                let flags: &mut [bool] = if tracked { &mut settled } else { &mut [] };
+                guide_step(
+                    &scene,
+                    &mut rows,
+                    &mut grads,
+                    &guides,
+                    1,
+                    0.1,
+                    CylinderBox::Enclosing,
+                    BoxFrame::Obstacle,
+                    flags,
+                )
+                .unwrap();
+            }
+            (rows, settled)
+        };
+        let (plain, _) = run(false);
+        let (tracked, settled) = run(true);
+        let bits = |r: &[[Joints<f32>; H]; 2]| r.map(|x| x.map(|q| q.map(f32::to_bits)));
+        assert_eq!(bits(&plain), bits(&tracked));
+        assert_eq!(
+            settled,
+            [false, true],
+            "the row through the wall moves, the far one settles"
+        );
+        assert_eq!(tracked[1], away);
+        // One flag per guide or none.
+        let mut rows = [through, away];
+        let mut grads = [[[0.0; 7]; H]; 2];
+        let err = guide_step(
+            &scene,
+            &mut rows,
+            &mut grads,
+            &guides,
+            1,
+            0.1,
+            CylinderBox::Enclosing,
+            BoxFrame::Obstacle,
+            &mut [false; 3],
+        );
+        assert_eq!(err, Err(Error::BadParameter));
     }
 
     #[test]
@@ -245,6 +334,7 @@ mod tests {
             f32::INFINITY,
             CylinderBox::Enclosing,
             BoxFrame::Obstacle,
+            &mut [],
         );
         assert_eq!(err, Err(Error::BadParameter));
         let mut short = [[[0.0f32; 7]; H]; 11];
@@ -258,6 +348,7 @@ mod tests {
             f32::INFINITY,
             CylinderBox::Enclosing,
             BoxFrame::Obstacle,
+            &mut [],
         );
         assert_eq!(err, Err(Error::BadParameter));
     }
@@ -280,6 +371,7 @@ mod tests {
             f32::INFINITY,
             CylinderBox::Enclosing,
             BoxFrame::Obstacle,
+            &mut [],
         )
         .unwrap();
         let moved = |rows: &[[Joints<f32>; H]; 1]| {
@@ -301,6 +393,7 @@ mod tests {
             0.02,
             CylinderBox::Enclosing,
             BoxFrame::Obstacle,
+            &mut [],
         )
         .unwrap();
         assert!(moved(&limited) <= 0.02 + 1e-6, "{}", moved(&limited));
@@ -315,6 +408,7 @@ mod tests {
                 bad,
                 CylinderBox::Enclosing,
                 BoxFrame::Obstacle,
+                &mut [],
             );
             assert_eq!(err, Err(Error::BadParameter));
         }

@@ -165,6 +165,17 @@ pub fn forward<T: Real>(q: &Joints<T>) -> Result<Kinematics<T>, Error> {
 /// Joints as in [`forward`] (checked first); an opening outside the URDF's finger limits
 /// (`robot::FINGER_OPENING_MIN..=FINGER_OPENING_MAX`), or NaN, is [`Error::BadParameter`].
 pub fn forward_with<T: Real>(q: &Joints<T>, finger: T) -> Result<Kinematics<T>, Error> {
+    let mut k = Kinematics {
+        frames: [Pose::identity(); FRAMES],
+        boxes: [Pose::identity(); BODIES],
+    };
+    forward_into(q, finger, &mut k)?;
+    Ok(k)
+}
+
+/// [`forward_with`] into `out`, in place (the costs' inner loop: no copy of the result). On an
+/// error `out` is unchanged.
+pub fn forward_into<T: Real>(q: &Joints<T>, finger: T, out: &mut Kinematics<T>) -> Result<(), Error> {
     for (i, &qi) in q.iter().enumerate() {
         if !qi.finite() {
             return Err(Error::NonFiniteJoint { joint: i as u8 });
@@ -174,7 +185,8 @@ pub fn forward_with<T: Real>(q: &Joints<T>, finger: T) -> Result<Kinematics<T>, 
     if !(finger >= robot.finger_lower && finger <= robot.finger_upper) {
         return Err(Error::BadParameter);
     }
-    let mut frames = [Pose::identity(); FRAMES];
+    let frames = &mut out.frames;
+    frames[0] = Pose::identity();
     for i in 1..FRAMES {
         let spec = &robot.frames[i];
         let rotation = match spec.joint.and_then(|j| q.get(j)) {
@@ -191,11 +203,10 @@ pub fn forward_with<T: Real>(q: &Joints<T>, finger: T) -> Result<Kinematics<T>, 
         let parent = frames[spec.parent.min(i - 1)];
         frames[i] = parent.compose(&rotation, &translation);
     }
-    let mut boxes = [Pose::identity(); BODIES];
-    for (pose, body) in boxes.iter_mut().zip(robot.bodies.iter()) {
-        *pose = frames[body.frame.min(FRAMES - 1)].compose(&body.rotation, &body.center);
+    for (pose, body) in out.boxes.iter_mut().zip(robot.bodies.iter()) {
+        *pose = out.frames[body.frame.min(FRAMES - 1)].compose(&body.rotation, &body.center);
     }
-    Ok(Kinematics { frames, boxes })
+    Ok(())
 }
 
 impl<T: Real> Kinematics<T> {

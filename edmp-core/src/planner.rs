@@ -312,26 +312,38 @@ pub fn polish<const B: usize, const N: usize>(
     Ok(())
 }
 
-/// One gradient step of every row's guide at diffusion step `t`, with the plan's step limit and
-/// boxes (the first stage's and the global stage's guidance alike).
-pub(crate) fn guide_batch<const B: usize, const N: usize>(
+/// `steps` gradient steps of every row's guide at diffusion step `t`, with the plan's step limit
+/// and boxes (the first stage's and the global stage's guidance alike). A guide whose rows stop
+/// moving is settled and skipped for the rest of the steps: at a fixed `t` its next step would
+/// be the same no-op, so this saves work and changes no bit ([`guide_step`]).
+pub(crate) fn guide_steps<const B: usize, const N: usize>(
     scene: &Scene<N>,
     paths: &mut [Path; B],
     grads: &mut [Path; B],
     guides: &[Guide],
     t: u16,
+    steps: u8,
     config: &PlanConfig,
 ) -> Result<(), Error> {
-    guide_step(
-        scene,
-        paths,
-        grads,
-        guides,
-        t,
-        config.step_limit,
-        config.cylinder,
-        config.frame,
-    )
+    let mut settled = [false; B];
+    let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
+    for _ in 0..steps {
+        guide_step(
+            scene,
+            paths,
+            grads,
+            guides,
+            t,
+            config.step_limit,
+            config.cylinder,
+            config.frame,
+            settled,
+        )?;
+        if settled.iter().all(|&s| s) {
+            break;
+        }
+    }
+    Ok(())
 }
 
 /// The guided reverse diffusion: `paths` end as the `B` candidates (not yet clamped or judged).
@@ -359,9 +371,9 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
             free_ends(x, rng);
         }
     }
-    // One gradient step of every row's guide at diffusion step `t`.
-    let guide =
-        |paths: &mut [Path; B], grads: &mut [Path; B], t: u16| guide_batch(scene, paths, grads, guides, t, config);
+    let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16, steps: u8| {
+        guide_steps(scene, paths, grads, guides, t, steps, config)
+    };
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
@@ -373,18 +385,14 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
                 config.sampler.advance(step, x, e, rng);
             }
         }
-        for _ in 0..config.guidance.steps_at(step.t) {
-            guide(paths, &mut work.grads, step.t)?;
-        }
+        guide(paths, &mut work.grads, step.t, config.guidance.steps_at(step.t))?;
     }
     if !config.condition {
         for x in paths.iter_mut() {
             inpaint(x, start, goal);
         }
     }
-    for _ in 0..config.refine {
-        guide(paths, &mut work.grads, 1)?;
-    }
+    guide(paths, &mut work.grads, 1, config.refine)?;
     Ok(())
 }
 
