@@ -18,7 +18,7 @@ use crate::checker::check_segment;
 use crate::error::Error;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::planner::{Plan, PlanConfig, Workspace, guide_steps, judge, rank_in_full, select};
+use crate::planner::{Plan, PlanConfig, Workspace, guide_steps, judge, rank_in_full, refine, select};
 use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise};
 use crate::rng::Rng;
 use crate::scene::Scene;
@@ -153,15 +153,25 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
             guide(&mut plan.paths, &mut work.grads, step.t, global.per_step)?;
         }
     }
-    guide(&mut plan.paths, &mut work.grads, 1, global.refine)?;
-    judge(scene, start, goal, config, plan)?;
+    refine(
+        scene,
+        start,
+        goal,
+        &mut plan.paths,
+        &mut work.grads,
+        guides,
+        global.refine,
+        config,
+        &mut work.certified,
+    )?;
+    judge(scene, start, goal, config, plan, &work.certified)?;
     plan.search = Some(searched);
     if plan.is_free() {
         plan.stage = Stage::Reseeded;
         return Ok(());
     }
     // The last resort: the search path itself, judged like a candidate, in the chosen row.
-    let own = select(scene, start, goal, config, [outcome.path])?;
+    let own = select(scene, start, goal, config, [outcome.path], &[false])?;
     if !own.is_free() {
         // The search checked every segment with the same checker, so only the checker's
         // carried-direction wrinkle near the margin could get here; a colliding path is never

@@ -29,6 +29,7 @@ use crate::scene::Scene;
 /// be the same no-op: skipping it saves the work and changes no bit. Clear the flags whenever
 /// `t` (or the scene) changes. Any other length is [`Error::BadParameter`].
 #[allow(clippy::too_many_arguments)]
+#[inline(never)] // one symbol for profiles (benchmarks/stage_instructions.py); it is large anyway
 pub fn guide_step<const H: usize, const N: usize>(
     scene: &Scene<N>,
     rows: &mut [[Joints<f32>; H]],

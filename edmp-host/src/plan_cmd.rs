@@ -12,7 +12,7 @@ use edmp_core::global::GlobalConfig;
 use edmp_core::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
-    PlanConfig, Workspace, denoise, finish, polish, select,
+    PlanConfig, RefineStop, Workspace, denoise, finish, polish, select,
 };
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
@@ -60,7 +60,8 @@ pub struct Tuning {
     /// Gradient steps of every guide after each denoising step (strided sampler).
     #[arg(long, default_value_t = DEFAULT_GRADIENT_STEPS)]
     gradient_steps: u8,
-    /// Refinement gradient steps of every guide after the last denoising step (at t = 1).
+    /// Refinement gradient steps of every guide after the last denoising step (at t = 1): a
+    /// budget that `--refine-check-every` may end early.
     #[arg(long, default_value_t = DEFAULT_REFINE_STEPS)]
     refine_steps: u8,
     /// Largest move of one joint in one gradient step, radians (`inf`: the original's
@@ -86,6 +87,14 @@ pub struct Tuning {
     /// checker): the path as the guides left it, as the paper.
     #[arg(long)]
     no_shortcut: bool,
+    /// End the refinement early: check the rows not yet free with the exact checker before the
+    /// first refinement step and every N steps after, stop moving the free ones, and stop once
+    /// `--refine-stop-free` rows are free (0: every refinement step runs).
+    #[arg(long, default_value_t = PlanConfig::DEFAULT.refine_stop.map_or(0, |s| s.every))]
+    refine_check_every: u8,
+    /// With `--refine-check-every`: how many free rows end the refinement (12 or more: all).
+    #[arg(long, default_value_t = PlanConfig::DEFAULT.refine_stop.map_or(RefineStop::DEFAULT.free, |s| s.free))]
+    refine_stop_free: u8,
     /// Global stage: sampling iterations of the search before it gives up.
     #[arg(long, default_value_t = SearchConfig::DEFAULT.max_iterations)]
     search_iterations: u32,
@@ -135,6 +144,10 @@ impl Tuning {
             } else {
                 PlanConfig::DEFAULT.shortcut
             },
+            refine_stop: (self.refine_check_every > 0).then_some(RefineStop {
+                every: self.refine_check_every,
+                free: self.refine_stop_free,
+            }),
             ..PlanConfig::DEFAULT
         };
         if self.step_limit.is_nan() || self.step_limit <= 0.0 {
@@ -142,6 +155,11 @@ impl Tuning {
                 "--step-limit: {} is not a positive number of radians",
                 self.step_limit
             )));
+        }
+        if self.refine_check_every > 0 && self.refine_stop_free == 0 {
+            return Err(Failure::Input(
+                "--refine-stop-free: 0 free rows cannot end the refinement (at least 1)".to_owned(),
+            ));
         }
         config.sampler.validate().map_err(|_| {
             Failure::Input(format!(
@@ -181,6 +199,20 @@ impl Tuning {
             format!("{boxes}, no shortcut")
         } else {
             boxes
+        };
+        let stop = (self.refine_check_every, self.refine_stop_free);
+        let default_stop = PlanConfig::DEFAULT
+            .refine_stop
+            .map_or((0, RefineStop::DEFAULT.free), |s| (s.every, s.free));
+        let boxes = if stop == default_stop {
+            boxes
+        } else if self.refine_check_every == 0 {
+            format!("{boxes}, every refinement step runs")
+        } else {
+            format!(
+                "{boxes}, refinement checked every {} steps, ends at {} free",
+                self.refine_check_every, self.refine_stop_free
+            )
         };
         if self.ancestral {
             format!(
@@ -244,7 +276,7 @@ pub fn plan_problem(problem: &Problem, guides: &[Guide], config: &PlanConfig, se
     .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let denoise_ms = denoise_began.elapsed().as_secs_f64() * 1e3;
     let select_began = Instant::now();
-    let mut plan = select(&problem.scene, &problem.start, &goal, config, *paths)
+    let mut plan = select(&problem.scene, &problem.start, &goal, config, *paths, &work.certified)
         .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
     let global_began = Instant::now();

@@ -1,14 +1,15 @@
 //! Arbitrary scenes, ends and planner settings through the core planner with a short schedule:
 //! it must return a plan whose every candidate is finite, starts at the start and ends at the
 //! goal, or a typed error; never a panic, never a NaN. The work per input is bounded by the
-//! settings (at most 3 denoising steps, 2 gradient steps each, 12 rows).
+//! settings (at most 3 denoising steps, 2 gradient steps each, 12 rows); the refinement's early
+//! stop (`PlanConfig::refine_stop`) is fuzzed too, zero settings (typed errors) included.
 #![no_main]
 
 use edmp_core::checker::CheckConfig;
 use edmp_core::geometry::{BoxFrame, CylinderBox};
-use edmp_core::guides::EDMP_GUIDES;
 use edmp_core::global::GlobalConfig;
-use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
+use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::planner::{GuidanceSchedule, PlanConfig, RefineStop, Workspace, plan};
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
@@ -55,7 +56,7 @@ fuzz_target!(|data: &[u8]| {
     }
     let (start, goal) = (r.array::<7>(), r.array::<7>());
     let steps = u16::from(r.byte() % 4);
-    let config = PlanConfig {
+    let mut config = PlanConfig {
         sampler: if r.byte() & 1 == 0 {
             Sampler::Strided { steps }
         } else {
@@ -66,7 +67,11 @@ fuzz_target!(|data: &[u8]| {
         refine: r.byte() % 3,
         step_limit: if r.byte() & 1 == 0 { f32::INFINITY } else { 0.1 },
         cylinder: CylinderBox::Enclosing,
-        frame: if r.byte() & 1 == 0 { BoxFrame::Obstacle } else { BoxFrame::World },
+        frame: if r.byte() & 1 == 0 {
+            BoxFrame::Obstacle
+        } else {
+            BoxFrame::World
+        },
         check: CheckConfig::default(),
         // The global stage with a small, fuzzed budget and noise level (it runs only when no
         // candidate is free, which most fuzzed scenes reach).
@@ -95,11 +100,19 @@ fuzz_target!(|data: &[u8]| {
                 smoothing: r.byte() % 4,
             })
         },
+        refine_stop: None,
     };
     let guides = &EDMP_GUIDES[..[1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)]];
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<12>::new());
     let seed = u64::from(r.byte());
+    // Read last, so the inputs kept from before it still mean what they meant.
+    if r.byte() & 1 == 1 {
+        config.refine_stop = Some(RefineStop {
+            every: r.byte() % 4,
+            free: r.byte() % 14,
+        });
+    }
     if let Ok(p) = plan(
         &scene,
         &start,
