@@ -9,7 +9,9 @@ shared 2-core machine. Standard library only; needs valgrind (callgrind_annotate
 Runs `B plan P -o /dev/null` under `valgrind --tool=callgrind` for every K-th problem (sorted)
 of each family folder, then prints one row per problem and the median of each column: the whole
 plan, and inclusive counts of the network (`predict_noise`), the guidance (`guide_step`), the
-selection (`judge`), the global stage (`global::rescue`) and the shortening (`shortcut::shorten`).
+selection (`judge`), the global stage (`global::rescue`, or its caller `planner::finish`) and the shortening (`shortcut::shorten`),
+and the costs with their gradients (`cost::trajectory_cost`: the guidance's work, plus the
+judge's swept volumes; a column that does not depend on what the compiler inlined).
 A stage's count is inclusive: the global stage's network and guidance are counted in it too.
 """
 
@@ -25,8 +27,9 @@ from pathlib import Path
 STAGES = {
     "network": "edmp_core::prior::net::predict_noise",
     "guidance": "edmp_core::guidance::guide_step",
+    "costs": "edmp_core::cost::trajectory_cost",
     "select": "edmp_core::planner::judge",
-    "global": "edmp_core::global::rescue",
+    "global": ("edmp_core::global::rescue", "edmp_core::planner::finish"),
     "shortcut": "edmp_core::shortcut::shorten",
 }
 
@@ -51,12 +54,14 @@ def count(binary: str, problem: Path, extra: list[str]) -> dict[str, int]:
     m = re.search(r"^\s*([\d,]+) \(100\.0+%\)\s+PROGRAM TOTALS", text, re.M)
     if m:
         row["total"] = int(m.group(1).replace(",", ""))
-    for stage, symbol in STAGES.items():
+    for stage, symbols in STAGES.items():
         # The largest inclusive count among the lines naming the function (callgrind lists a
         # function once per file its inlined code came from; the largest is the function itself).
+        # A stage may name two functions, the second one's caller, in case one was inlined.
         best = 0
+        pattern = "|".join(re.escape(s) for s in ([symbols] if isinstance(symbols, str) else symbols))
         for line in text.splitlines():
-            if re.search(r":" + re.escape(symbol) + r"(?:[\s<]|$)", line):
+            if re.search(r":(?:" + pattern + r")(?:[\s<]|$)", line):
                 m = re.match(r"\s*([\d,]+)", line)
                 if m:
                     best = max(best, int(m.group(1).replace(",", "")))
