@@ -359,22 +359,35 @@ pub(crate) fn guide_steps<const B: usize, const N: usize>(
     let mut settled = [false; B];
     let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
     for _ in 0..steps {
-        guide_step(
-            scene,
-            paths,
-            grads,
-            guides,
-            t,
-            config.step_limit,
-            config.cylinder,
-            config.frame,
-            settled,
-        )?;
+        guide_once(scene, paths, grads, guides, t, config, settled)?;
         if settled.iter().all(|&s| s) {
             break;
         }
     }
     Ok(())
+}
+
+/// One [`guide_step`] with the plan's step limit and boxes.
+fn guide_once<const B: usize, const N: usize>(
+    scene: &Scene<N>,
+    paths: &mut [Path; B],
+    grads: &mut [Path; B],
+    guides: &[Guide],
+    t: u16,
+    config: &PlanConfig,
+    settled: &mut [bool],
+) -> Result<(), Error> {
+    guide_step(
+        scene,
+        paths,
+        grads,
+        guides,
+        t,
+        config.step_limit,
+        config.cylinder,
+        config.frame,
+        settled,
+    )
 }
 
 /// The refinement: `steps` gradient steps of every row's guide at t = 1, ended early by
@@ -420,17 +433,7 @@ pub(crate) fn refine<const B: usize, const N: usize>(
                 }
             }
         }
-        guide_step(
-            scene,
-            paths,
-            grads,
-            guides,
-            1,
-            config.step_limit,
-            config.cylinder,
-            config.frame,
-            settled,
-        )?;
+        guide_once(scene, paths, grads, guides, 1, config, settled)?;
         if settled.iter().all(|&s| s) {
             break;
         }
