@@ -149,11 +149,14 @@ const IDLE: RobotBox = RobotBox {
 };
 
 impl RobotBox {
-    fn new(pose: Pose<f32>, half: Vector3<f32>) -> Self {
+    /// `radius` is `|half|`, computed once per cost evaluation ([`radius_of`]), not per
+    /// waypoint: a square root per box and waypoint was a fifth of a plan's time on x86-64-v3,
+    /// where `libm`'s `sqrtss` (not VEX-encoded) stalls among the AVX code around it.
+    fn new(pose: Pose<f32>, half: Vector3<f32>, radius: f32) -> Self {
         Self {
             pose,
             half,
-            radius: libm::sqrtf(half.norm_squared()),
+            radius,
             active: true,
         }
     }
@@ -181,6 +184,11 @@ impl RobotBox {
             arg,
         )
     }
+}
+
+/// `|half|`, the radius of a box's ball.
+fn radius_of(half: &Vector3<f32>) -> f32 {
+    libm::sqrtf(half.norm_squared())
 }
 
 /// The held object's box in the hand frame.
@@ -246,14 +254,15 @@ impl Waypoint {
 
     /// Places the boxes of the kinematics in `self.k` (and the held object's) and clears the
     /// gradient.
-    fn place(&mut self, held: Option<(&Pose<f32>, Vector3<f32>)>) {
+    /// `radii` holds every slot's `|half|` (the held object's last).
+    fn place(&mut self, held: Option<(&Pose<f32>, Vector3<f32>)>, radii: &[f32; SLOTS]) {
         let k = &self.k;
         let boxes = &mut self.boxes;
         *boxes = [IDLE; SLOTS];
-        for (b, slot) in boxes.iter_mut().enumerate().take(BODIES) {
+        for (b, (slot, &radius)) in boxes.iter_mut().zip(radii).enumerate().take(BODIES) {
             // Bodies on the fixed root (link0) never move and are not checked against obstacles.
             if PANDA.bodies[b].frame != 0 {
-                *slot = RobotBox::new(k.boxes[b], PANDA.bodies[b].half_extents);
+                *slot = RobotBox::new(k.boxes[b], PANDA.bodies[b].half_extents, radius);
             }
         }
         if let Some((local, half)) = held {
@@ -262,7 +271,7 @@ impl Waypoint {
                 rotation: hand.rotation * local.rotation,
                 translation: hand.transform_point(&local.translation),
             };
-            boxes[HELD] = RobotBox::new(pose, half);
+            boxes[HELD] = RobotBox::new(pose, half, radii[HELD]);
         }
         let mut hull: Option<Aabb> = None;
         self.balls = [NO_BOX; SLOTS];
@@ -338,6 +347,11 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
         .held()
         .map(|h| (held_local_pose(h), box_dims(&h.shape, config.cylinder) * 0.5));
     let held = held.as_ref().map(|(pose, half)| (pose, *half));
+    let mut radii = [0.0f32; SLOTS];
+    for (r, body) in radii.iter_mut().zip(PANDA.bodies.iter()) {
+        *r = radius_of(&body.half_extents);
+    }
+    radii[HELD] = held.map_or(0.0, |(_, half)| radius_of(&half));
 
     let mut gradient = gradient;
     let mut total = 0.0f32;
@@ -348,7 +362,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     for (w, q) in trajectory.iter().enumerate() {
         // The scene's finger opening places the finger boxes; for the adjoint it is a constant.
         forward_into(q, scene.gripper(), &mut current.k)?;
-        current.place(held);
+        current.place(held, &radii);
         match config.kind {
             CostKind::Intersection if w > 0 && w + 1 < H => total += intersection(current, obstacles),
             CostKind::Swept if w > 0 => total += swept(before, current, obstacles),
