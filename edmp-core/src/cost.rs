@@ -220,7 +220,7 @@ struct Waypoint {
     k: Kinematics<f32>,
     boxes: [RobotBox; SLOTS],
     /// Per box, a world AABB holding its AABB in any frame, and their union (broad phase).
-    balls: [Aabb; SLOTS],
+    balls: SlotBoxes,
     hull: Aabb,
     pulls: Pulls,
 }
@@ -244,7 +244,7 @@ impl Waypoint {
             boxes: [IDLE.pose; BODIES],
         },
         boxes: [IDLE; SLOTS],
-        balls: [NO_BOX; SLOTS],
+        balls: SlotBoxes::EMPTY,
         hull: NO_BOX,
         pulls: Pulls {
             corners: [[Vector3::new(0.0, 0.0, 0.0); CORNERS]; SLOTS],
@@ -274,16 +274,17 @@ impl Waypoint {
             boxes[HELD] = RobotBox::new(pose, half, radii[HELD]);
         }
         let mut hull: Option<Aabb> = None;
-        self.balls = [NO_BOX; SLOTS];
-        for (b, ball) in boxes.iter().zip(self.balls.iter_mut()).filter(|(b, _)| b.active) {
+        self.balls = SlotBoxes::EMPTY;
+        for (s, b) in boxes.iter().enumerate().filter(|(_, b)| b.active) {
             // Each AABB of the box lies in a cube of half side `radius` in its frame, so in a
             // ball of radius √3·radius.
             let r = Vector3::repeat(1.732_051 * b.radius);
-            *ball = Aabb {
+            let ball = Aabb {
                 min: b.pose.translation - r,
                 max: b.pose.translation + r,
             };
-            hull = Some(hull.map_or(*ball, |h| h.union(ball)));
+            self.balls.set(s, &ball);
+            hull = Some(hull.map_or(ball, |h| h.union(&ball)));
         }
         self.hull = hull.unwrap_or(NO_BOX);
         self.pulls = Pulls {
@@ -406,6 +407,72 @@ fn overlaps(a: &Aabb, b: &Aabb) -> bool {
     hi.x > lo.x && hi.y > lo.y && hi.z > lo.z
 }
 
+/// Lanes of [`SlotBoxes`]: every slot, rounded up to two AVX registers.
+const LANES: usize = 16;
+const _: () = assert!(SLOTS <= LANES && LANES <= 16);
+
+/// One box per robot slot, as structure of arrays (a lane per slot, an array per bound and
+/// axis), so that the broad phase tests every slot against one obstacle in a few vector
+/// compares instead of a branch per slot. An unused lane is empty (min +∞, max −∞).
+#[derive(Clone, Copy, Debug)]
+struct SlotBoxes {
+    min: [[f32; LANES]; 3],
+    max: [[f32; LANES]; 3],
+    /// Bit `s` set where lane `s` holds a box of positive volume.
+    solid: u16,
+}
+
+impl SlotBoxes {
+    const EMPTY: Self = Self {
+        min: [[f32::INFINITY; LANES]; 3],
+        max: [[f32::NEG_INFINITY; LANES]; 3],
+        solid: 0,
+    };
+
+    fn set(&mut self, slot: usize, b: &Aabb) {
+        for k in 0..3 {
+            if let (Some(lo), Some(hi)) = (self.min[k].get_mut(slot), self.max[k].get_mut(slot)) {
+                (*lo, *hi) = (b.min[k], b.max[k]);
+            }
+        }
+        let solid = b.max.x > b.min.x && b.max.y > b.min.y && b.max.z > b.min.z;
+        if solid && slot < LANES {
+            self.solid |= 1 << slot;
+        }
+    }
+
+    /// Bit `s` set exactly where [`overlaps`] holds for slot `s`'s box and `o`: for finite
+    /// bounds `min(a.max, o.max) > max(a.min, o.min)` on an axis is `a.max > o.min`,
+    /// `o.max > a.min` and both boxes' own `max > min`, so the decisions (and the costs' bits)
+    /// are the scalar test's.
+    fn overlapping(&self, o: &Aabb) -> u16 {
+        if !(o.max.x > o.min.x && o.max.y > o.min.y && o.max.z > o.min.z) {
+            return 0;
+        }
+        let [lx, ly, lz] = [o.min.x, o.min.y, o.min.z];
+        let [hx, hy, hz] = [o.max.x, o.max.y, o.max.z];
+        let [min_x, min_y, min_z] = &self.min;
+        let [max_x, max_y, max_z] = &self.max;
+        let mut mask = 0u16;
+        for s in 0..LANES {
+            let hit = (max_x[s] > lx) & (hx > min_x[s]) & (max_y[s] > ly) & (hy > min_y[s]) & (max_z[s] > lz) & (hz > min_z[s]);
+            mask |= u16::from(hit) << s;
+        }
+        mask & self.solid
+    }
+}
+
+/// The set bits of a slot mask, lowest first (the slots' order of the scalar loops).
+fn slots_of(mut mask: u16) -> impl Iterator<Item = usize> {
+    core::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let s = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            s
+        })
+    })
+}
+
 /// Intersection volume of one interior waypoint's boxes; adds its gradient to the waypoint.
 fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     let mut total = 0.0;
@@ -417,10 +484,8 @@ fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
         ..
     } = w;
     for o in obstacles.iter().filter(|o| overlaps(hull, &o.world)) {
-        for (s, (b, ball)) in boxes.iter().zip(balls.iter()).enumerate() {
-            if !b.active || !overlaps(ball, &o.world) {
-                continue;
-            }
+        for s in slots_of(balls.overlapping(&o.world)) {
+            let Some(b) = boxes.get(s) else { continue };
             let c = o.local(&b.pose.translation);
             if (0..3).any(|k| o.apart_on(&c, b.radius, k)) {
                 continue;
@@ -445,34 +510,31 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
     // In an obstacle's frame the union of the two ends' AABBs lies in a ball around the
     // midpoint of radius |ca − cb| / 2 + √3·|half| (not in the world-axis union of the ends'
     // balls: the frame may be turned).
-    let mut reach = [Aabb {
-        min: Vector3::zeros(),
-        max: Vector3::zeros(),
-    }; SLOTS];
+    let mut reach = SlotBoxes::EMPTY;
     let mut hull: Option<Aabb> = None;
-    for ((ba, bb), r) in a.boxes.iter().zip(b.boxes.iter()).zip(reach.iter_mut()) {
+    for (s, (ba, bb)) in a.boxes.iter().zip(b.boxes.iter()).enumerate() {
         if !ba.active {
             continue;
         }
         let (pa, pb) = (ba.pose.translation, bb.pose.translation);
         let radius = 0.5 * libm::sqrtf((pa - pb).norm_squared()) + 1.732_051 * ba.radius.max(bb.radius);
         let mid = (pa + pb) * 0.5;
-        *r = Aabb {
+        let r = Aabb {
             min: mid - Vector3::repeat(radius),
             max: mid + Vector3::repeat(radius),
         };
-        hull = Some(hull.map_or(*r, |h| h.union(r)));
+        reach.set(s, &r);
+        hull = Some(hull.map_or(r, |h| h.union(&r)));
     }
     let Some(hull) = hull else {
         return 0.0;
     };
     let (boxes_a, pulls_a, boxes_b, pulls_b) = (&a.boxes, &mut a.pulls, &b.boxes, &mut b.pulls);
     for o in obstacles.iter().filter(|o| overlaps(&hull, &o.world)) {
-        let ends = boxes_a.iter().zip(boxes_b.iter());
-        for (s, ((box_a, box_b), r)) in ends.zip(reach.iter()).enumerate() {
-            if !box_a.active || !overlaps(r, &o.world) {
+        for s in slots_of(reach.overlapping(&o.world)) {
+            let (Some(box_a), Some(box_b)) = (boxes_a.get(s), boxes_b.get(s)) else {
                 continue;
-            }
+            };
             let (ca, cb) = (o.local(&box_a.pose.translation), o.local(&box_b.pose.translation));
             // Both ends' AABBs beyond the box on the same side of one axis: the union is too.
             if (0..3).any(|k| {
