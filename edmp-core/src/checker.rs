@@ -416,7 +416,27 @@ pub fn check_trajectory<const H: usize, const N: usize>(
             first_contact: None,
         });
     };
-    check_path(scene, trajectory, [first, last], config, stop_at_first)
+    check_path(scene, trajectory, [first, last], config, stop_at_first, 0)
+}
+
+/// [`check_trajectory`] stopping at the first contact, walking the segments from `first`
+/// (then on to the last and round to segment 0): where a path touched at its last check it
+/// most likely touches again, and a contact found there ends the walk at once. Whether the path
+/// is free does not depend on the order; which contact is reported first does.
+pub fn check_trajectory_from<const H: usize, const N: usize>(
+    scene: &Scene<N>,
+    trajectory: &[Joints<f32>; H],
+    config: &CheckConfig,
+    first: usize,
+) -> Result<TrajectoryReport, Error> {
+    let (Some(start), Some(end)) = (trajectory.first(), trajectory.last()) else {
+        return Ok(TrajectoryReport {
+            states: 0,
+            colliding_states: 0,
+            first_contact: None,
+        });
+    };
+    check_path(scene, trajectory, [start, end], config, true, first)
 }
 
 /// Checks the straight segment `a → b` (both ends included) of a path whose ends are `ends`
@@ -428,7 +448,7 @@ pub fn check_segment<const N: usize>(
     ends: [&Joints<f32>; 2],
     config: &CheckConfig,
 ) -> Result<bool, Error> {
-    Ok(check_path(scene, &[*a, *b], ends, config, true)?.is_free())
+    Ok(check_path(scene, &[*a, *b], ends, config, true, 0)?.is_free())
 }
 
 /// Whether `q` lies within `radius` (max-norm) of `end`.
@@ -442,6 +462,7 @@ fn check_path<const N: usize>(
     ends: [&Joints<f32>; 2],
     config: &CheckConfig,
     stop_at_first: bool,
+    first: usize,
 ) -> Result<TrajectoryReport, Error> {
     let mut prepared = Prepared::new(scene, config)?;
     let mut report = TrajectoryReport {
@@ -449,7 +470,10 @@ fn check_path<const N: usize>(
         colliding_states: 0,
         first_contact: None,
     };
-    for (segment, q) in trajectory.iter().enumerate() {
+    let count = trajectory.len();
+    let first = if first < count { first } else { 0 };
+    for segment in (first..count).chain(0..first) {
+        let Some(q) = trajectory.get(segment) else { continue };
         let next = trajectory.get(segment + 1);
         let steps = match next {
             Some(b) => segment_steps(q, b, config.max_step)?,

@@ -11,7 +11,7 @@
 //! most twice: once to its first contact, once in full when no candidate is free). The global
 //! stage adds a bounded amount on top ([`crate::global`] states it).
 
-use crate::checker::{CheckConfig, check_trajectory};
+use crate::checker::{CheckConfig, check_trajectory, check_trajectory_from};
 use crate::cost::{CostConfig, CostKind, trajectory_cost};
 use crate::error::Error;
 use crate::geometry::{BoxFrame, CylinderBox, Inflation};
@@ -414,12 +414,19 @@ pub(crate) fn refine<const B: usize, const N: usize>(
     let per_guide = B / guides.len();
     let mut settled = [false; B];
     let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
+    // The segment where each row touched at its last check: the next check walks from there,
+    // where a row that still touches most likely does.
+    let mut touched: [Option<u16>; B] = [None; B];
     for s in 0..steps {
         if s % stop.every == 0 {
-            for (x, done) in paths.iter().zip(certified.iter_mut()).filter(|(_, done)| !**done) {
+            let rows = paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut());
+            for ((x, done), touched) in rows.filter(|((_, done), _)| !**done) {
                 let mut judged = *x;
                 clamp_for_judging(&mut judged, start, goal);
-                *done = check_trajectory(scene, &judged, &config.check, true)?.is_free();
+                let from = touched.map_or(0, usize::from);
+                let report = check_trajectory_from(scene, &judged, &config.check, from)?;
+                *done = report.is_free();
+                *touched = report.first_contact.map(|c| c.segment);
             }
             if certified.iter().filter(|&&c| c).count() >= usize::from(stop.free) {
                 return Ok(());
