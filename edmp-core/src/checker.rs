@@ -630,6 +630,49 @@ mod tests {
 
     #[test]
     #[cfg_attr(miri, ignore = "the exact checker at many states: hours under Miri")]
+    fn a_walk_from_any_segment_finds_the_same_verdict_and_from_the_contact_finds_it_at_once() {
+        // Joint 1 swings through a thin wall in 10 segments; only the middle ones touch it.
+        let (a, b) = (
+            [-1.2f32, -0.3, 0.0, -2.0, 0.0, 1.8, 0.785],
+            [1.2f32, -0.3, 0.0, -2.0, 0.0, 1.8, 0.785],
+        );
+        let path: [Joints<f32>; 11] =
+            core::array::from_fn(|i| core::array::from_fn(|j| a[j] + (b[j] - a[j]) * i as f32 / 10.0));
+        let mut scene = Scene::<4>::new();
+        scene
+            .push(Obstacle::cuboid([0.6, 0.0, 0.5], [0.4, 0.005, 0.4], ID).unwrap())
+            .unwrap();
+        let cfg = CheckConfig::default();
+        let plain = check_trajectory(&scene, &path, &cfg, true).unwrap();
+        let hit = plain.first_contact.expect("the swing touches the wall").segment;
+        for first in 0..14 {
+            let from = check_trajectory_from(&scene, &path, &cfg, first).unwrap();
+            assert!(!from.is_free(), "from segment {first}");
+            assert_eq!(from.colliding_states, 1, "it stops at the first contact");
+        }
+        let at_contact = check_trajectory_from(&scene, &path, &cfg, usize::from(hit)).unwrap();
+        assert!(
+            at_contact.states < plain.states,
+            "{} vs {}",
+            at_contact.states,
+            plain.states
+        );
+        // A free path is walked in full whatever the first segment: every state once.
+        let (c, d) = (
+            [-1.2f32, -0.3, 0.0, -2.0, 0.0, 1.8, 0.785],
+            [-0.6f32, -0.3, 0.0, -2.0, 0.0, 1.8, 0.785],
+        );
+        let free: [Joints<f32>; 11] =
+            core::array::from_fn(|i| core::array::from_fn(|j| c[j] + (d[j] - c[j]) * i as f32 / 10.0));
+        let whole = check_trajectory(&scene, &free, &cfg, true).unwrap();
+        assert!(whole.is_free());
+        for first in [0, 4, 10] {
+            assert_eq!(check_trajectory_from(&scene, &free, &cfg, first).unwrap(), whole);
+        }
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the exact checker at many states: hours under Miri")]
     fn self_contact_when_the_hand_folds_onto_the_base() {
         // Joint 4 at its lower limit with joint 2 forward folds link7/hand towards link1-2.
         let folded = [0.0, 1.7, 0.0, -3.07, 0.0, 0.0, 0.0];

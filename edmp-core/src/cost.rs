@@ -455,7 +455,12 @@ impl SlotBoxes {
         let [max_x, max_y, max_z] = &self.max;
         let mut mask = 0u16;
         for s in 0..LANES {
-            let hit = (max_x[s] > lx) & (hx > min_x[s]) & (max_y[s] > ly) & (hy > min_y[s]) & (max_z[s] > lz) & (hz > min_z[s]);
+            let hit = (max_x[s] > lx)
+                & (hx > min_x[s])
+                & (max_y[s] > ly)
+                & (hy > min_y[s])
+                & (max_z[s] > lz)
+                & (hz > min_z[s]);
             mask |= u16::from(hit) << s;
         }
         mask & self.solid

@@ -18,7 +18,7 @@ use crate::checker::check_segment;
 use crate::error::Error;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::planner::{Plan, PlanConfig, Workspace, guide_steps, judge, rank_in_full, refine, select};
+use crate::planner::{Plan, PlanConfig, RowChecks, Workspace, guide_steps, judge, rank_in_full, refine, select};
 use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise};
 use crate::rng::Rng;
 use crate::scene::Scene;
@@ -162,16 +162,16 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
         guides,
         global.refine,
         config,
-        &mut work.certified,
+        &mut work.checks,
     )?;
-    judge(scene, start, goal, config, plan, &work.certified)?;
+    judge(scene, start, goal, config, plan, &work.checks)?;
     plan.search = Some(searched);
     if plan.is_free() {
         plan.stage = Stage::Reseeded;
         return Ok(());
     }
     // The last resort: the search path itself, judged like a candidate, in the chosen row.
-    let own = select(scene, start, goal, config, [outcome.path], &[false])?;
+    let own = select(scene, start, goal, config, [outcome.path], &RowChecks::NONE)?;
     if !own.is_free() {
         // The search checked every segment with the same checker, so only the checker's
         // carried-direction wrinkle near the margin could get here; a colliding path is never

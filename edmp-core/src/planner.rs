@@ -246,9 +246,8 @@ pub const DEFAULT_SEARCH_NODES: usize = 512;
 pub struct Workspace<const B: usize, const CAP: usize = DEFAULT_SEARCH_NODES> {
     pub(crate) eps: [Path; B],
     pub(crate) grads: [Path; B],
-    /// Rows the refinement's early stop certified free and left as they were: the judge need
-    /// not check them again ([`RefineStop`]).
-    pub certified: [bool; B],
+    /// What the refinement's checks learned of each row, for the judge ([`RefineStop`]).
+    pub checks: RowChecks<B>,
     pub(crate) search: SearchSpace<CAP>,
 }
 
@@ -264,10 +263,30 @@ impl<const B: usize, const CAP: usize> Workspace<B, CAP> {
         Self {
             eps: [[[0.0; JOINTS]; HORIZON]; B],
             grads: [[[0.0; JOINTS]; HORIZON]; B],
-            certified: [false; B],
+            checks: RowChecks::NONE,
             search: SearchSpace::new(),
         }
     }
+}
+
+/// What the refinement's checks ([`RefineStop`]) learned of each row, for the judge: a row
+/// certified free and not moved since need not be checked again, and a row that touched is
+/// walked from the segment where it last did (where it most likely touches still; whether it
+/// is free does not depend on where the walk starts).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RowChecks<const B: usize> {
+    /// Certified free, in the form the judge checks (clamped, ends exact), and not moved since.
+    pub free: [bool; B],
+    /// The segment of each row's first contact at its last check.
+    pub touched: [Option<u16>; B],
+}
+
+impl<const B: usize> RowChecks<B> {
+    /// Nothing known: the judge checks every row from its start.
+    pub const NONE: Self = Self {
+        free: [false; B],
+        touched: [None; B],
+    };
 }
 
 /// Plans from `start` to `goal` in `scene` with `B` rows over `guides` (`B` a multiple of
@@ -287,7 +306,7 @@ pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     // One plan's memory throughout: denoised into, judged in place, reseeded in place.
     let mut plan = Plan::empty();
     denoise(scene, start, goal, guides, config, rng, scratch, work, &mut plan.paths)?;
-    judge(scene, start, goal, config, &mut plan, &work.certified)?;
+    judge(scene, start, goal, config, &mut plan, &work.checks)?;
     finish(scene, start, goal, guides, config, rng, scratch, work, &mut plan)?;
     polish(scene, start, goal, config, rng, &mut plan)?;
     Ok(plan)
@@ -402,9 +421,13 @@ pub(crate) fn refine<const B: usize, const N: usize>(
     guides: &[Guide],
     steps: u8,
     config: &PlanConfig,
-    certified: &mut [bool; B],
+    checks: &mut RowChecks<B>,
 ) -> Result<(), Error> {
-    *certified = [false; B];
+    *checks = RowChecks::NONE;
+    let RowChecks {
+        free: certified,
+        touched,
+    } = checks;
     let Some(stop) = config.refine_stop else {
         return guide_steps(scene, paths, grads, guides, 1, steps, config);
     };
@@ -414,9 +437,6 @@ pub(crate) fn refine<const B: usize, const N: usize>(
     let per_guide = B / guides.len();
     let mut settled = [false; B];
     let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
-    // The segment where each row touched at its last check: the next check walks from there,
-    // where a row that still touches most likely does.
-    let mut touched: [Option<u16>; B] = [None; B];
     for s in 0..steps {
         if s % stop.every == 0 {
             let rows = paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut());
@@ -514,7 +534,7 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
         guides,
         config.refine,
         config,
-        &mut work.certified,
+        &mut work.checks,
     )?;
     Ok(())
 }
@@ -525,19 +545,19 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
 /// The check of a colliding candidate stops at its first contact; only when no candidate is
 /// free are the colliding states counted in full, to rank the fallback ([`rank_in_full`]) —
 /// unless the global stage is to run, which counts them only if it too finds nothing. A free
-/// candidate is checked state by state to the end either way, unless `certified` says the
-/// refinement's early stop already did (`Workspace::certified` after [`denoise`]; all `false`:
-/// check every candidate).
+/// candidate is checked state by state to the end either way, unless `checks` says the
+/// refinement's early stop already did (`Workspace::checks` after [`denoise`];
+/// [`RowChecks::NONE`]: check every candidate).
 pub fn select<const B: usize, const N: usize>(
     scene: &Scene<N>,
     start: &Joints<f32>,
     goal: &Joints<f32>,
     config: &PlanConfig,
     paths: [Path; B],
-    certified: &[bool; B],
+    checks: &RowChecks<B>,
 ) -> Result<Plan<B>, Error> {
     let mut plan = Plan { paths, ..Plan::empty() };
-    judge(scene, start, goal, config, &mut plan, certified)?;
+    judge(scene, start, goal, config, &mut plan, checks)?;
     Ok(plan)
 }
 
@@ -549,7 +569,7 @@ pub fn judge<const B: usize, const N: usize>(
     goal: &Joints<f32>,
     config: &PlanConfig,
     plan: &mut Plan<B>,
-    certified: &[bool; B],
+    checks: &RowChecks<B>,
 ) -> Result<(), Error> {
     if B == 0 {
         return Err(Error::BadParameter);
@@ -561,13 +581,15 @@ pub fn judge<const B: usize, const N: usize>(
         cylinder: config.cylinder,
         frame: config.frame,
     };
-    for ((x, verdict), &known_free) in paths.iter_mut().zip(verdicts.iter_mut()).zip(certified) {
+    let known = checks.free.iter().zip(&checks.touched);
+    for ((x, verdict), (&known_free, touched)) in paths.iter_mut().zip(verdicts.iter_mut()).zip(known) {
         clamp_for_judging(x, start, goal);
         // A certified row was checked in this very form (clamped, ends exact) and not moved.
         let colliding_states = if known_free {
             0
         } else {
-            check_trajectory(scene, x, &config.check, true)?.colliding_states
+            let from = touched.map_or(0, usize::from);
+            check_trajectory_from(scene, x, &config.check, from)?.colliding_states
         };
         *verdict = Verdict {
             swept: trajectory_cost(scene, x, &swept, None)?,
@@ -706,7 +728,7 @@ mod tests {
         });
         let cfg = config();
         // None free: every candidate's contacts are counted in full; ties go to the lower row.
-        let none = select(&scene, &START, &GOAL, &cfg, [straight, straight], &[false; 2]).unwrap();
+        let none = select(&scene, &START, &GOAL, &cfg, [straight, straight], &RowChecks::NONE).unwrap();
         assert!(!none.is_free());
         assert!(none.verdicts.iter().all(|v| !v.free && v.colliding_states > 1));
         assert_eq!(none.best, 0);
@@ -715,7 +737,7 @@ mod tests {
         let mut work = Box::new(Workspace::<12>::new());
         let planned = plan_wall(&GOAL, &mut scratch, &mut work).unwrap();
         let free = planned.paths[planned.best];
-        let one = select(&scene, &START, &GOAL, &cfg, [straight, free], &[false; 2]).unwrap();
+        let one = select(&scene, &START, &GOAL, &cfg, [straight, free], &RowChecks::NONE).unwrap();
         assert_eq!(one.best, 1);
         assert!(one.verdicts[1].free && one.verdicts[1].colliding_states == 0);
         assert!(!one.verdicts[0].free && one.verdicts[0].colliding_states == 1);
@@ -839,7 +861,10 @@ mod tests {
             };
             let mut paths = batch;
             let mut grads = [[[0.0; JOINTS]; HORIZON]; 12];
-            let mut certified = [true; 12];
+            let mut checks = RowChecks {
+                free: [true; 12],
+                touched: [Some(3); 12],
+            };
             refine(
                 &scene,
                 &START,
@@ -849,9 +874,9 @@ mod tests {
                 &EDMP_GUIDES,
                 steps,
                 &cfg,
-                &mut certified,
+                &mut checks,
             )
-            .map(|()| (paths, certified))
+            .map(|()| (paths, checks.free))
         };
         let free_rows = [[false; 6], [true; 6]].concat();
         // One free row is enough: nothing moves, and the judge is told which rows are free.

@@ -276,7 +276,7 @@ pub fn plan_problem(problem: &Problem, guides: &[Guide], config: &PlanConfig, se
     .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let denoise_ms = denoise_began.elapsed().as_secs_f64() * 1e3;
     let select_began = Instant::now();
-    let mut plan = select(&problem.scene, &problem.start, &goal, config, *paths, &work.certified)
+    let mut plan = select(&problem.scene, &problem.start, &goal, config, *paths, &work.checks)
         .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
     let global_began = Instant::now();
