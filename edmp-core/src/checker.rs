@@ -441,6 +441,10 @@ pub fn check_trajectory_from<const H: usize, const N: usize>(
 
 /// Checks the straight segment `a → b` (both ends included) of a path whose ends are `ends`
 /// (the problem's start and goal): what a search over the checker asks of each edge.
+///
+/// The same states as [`check_trajectory`] on `[a, b]`, in another order: `b` first, then
+/// from `a` on. A search's `a` is a node already known free and its `b` the new step, so an
+/// edge that collides mostly does so at `b`, which one state then proves.
 pub fn check_segment<const N: usize>(
     scene: &Scene<N>,
     a: &Joints<f32>,
@@ -448,7 +452,27 @@ pub fn check_segment<const N: usize>(
     ends: [&Joints<f32>; 2],
     config: &CheckConfig,
 ) -> Result<bool, Error> {
-    Ok(check_path(scene, &[*a, *b], ends, config, true, 0)?.is_free())
+    let mut prepared = Prepared::new(scene, config)?;
+    let steps = segment_steps(a, b, config.max_step)?;
+    if prepared.contact_at(b, margin_at(b, ends, config))?.is_some() {
+        return Ok(false);
+    }
+    for step in 0..steps {
+        let state = interpolate(a, b, step, steps);
+        if prepared.contact_at(&state, margin_at(&state, ends, config))?.is_some() {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
+/// The obstacle clearance state `q` must keep: `end_margin` near an end, `margin` elsewhere.
+fn margin_at(q: &Joints<f32>, ends: [&Joints<f32>; 2], config: &CheckConfig) -> f32 {
+    if ends.iter().any(|e| within(q, e, config.end_radius)) {
+        config.end_margin
+    } else {
+        config.margin
+    }
 }
 
 /// Whether `q` lies within `radius` (max-norm) of `end`.
@@ -485,9 +509,7 @@ fn check_path<const N: usize>(
                 None => *q,
             };
             report.states += 1;
-            let near_end = ends.iter().any(|e| within(&state, e, config.end_radius));
-            let margin = if near_end { config.end_margin } else { config.margin };
-            if let Some(contact) = prepared.contact_at(&state, margin)? {
+            if let Some(contact) = prepared.contact_at(&state, margin_at(&state, ends, config))? {
                 report.colliding_states += 1;
                 if report.first_contact.is_none() {
                     report.first_contact = Some(StateContact {
