@@ -225,12 +225,16 @@ struct Waypoint {
     pulls: Pulls,
 }
 
-/// The gradient on each box's corners (world vectors; `touched` once anything was added).
+/// The gradient on each box's corners (world vectors). Bit `s` of `touched` is set once
+/// anything was added to slot `s`; the corners of an untouched slot are stale, not zero, so
+/// that placing a waypoint does not clear a kilobyte it mostly never reads.
 #[derive(Clone, Copy, Debug)]
 struct Pulls {
     corners: [[Vector3<f32>; CORNERS]; SLOTS],
-    touched: bool,
+    touched: u16,
 }
+
+const _: () = assert!(SLOTS <= 16);
 
 const NO_BOX: Aabb = Aabb {
     min: Vector3::new(0.0, 0.0, 0.0),
@@ -248,7 +252,7 @@ impl Waypoint {
         hull: NO_BOX,
         pulls: Pulls {
             corners: [[Vector3::new(0.0, 0.0, 0.0); CORNERS]; SLOTS],
-            touched: false,
+            touched: 0,
         },
     };
 
@@ -287,19 +291,20 @@ impl Waypoint {
             hull = Some(hull.map_or(ball, |h| h.union(&ball)));
         }
         self.hull = hull.unwrap_or(NO_BOX);
-        self.pulls = Pulls {
-            corners: [[Vector3::zeros(); CORNERS]; SLOTS],
-            touched: false,
-        };
+        self.pulls.touched = 0;
     }
 }
 
 impl Pulls {
     /// Adds the gradient on one bound (axis `k` of the obstacle's frame) to the corner that set it.
     fn add(&mut self, slot: usize, corner: u8, o: &ObstacleBox, k: usize, g: f32) {
-        self.touched = true;
+        let slot = slot % SLOTS;
+        if self.touched & (1 << slot) == 0 {
+            self.touched |= 1 << slot;
+            self.corners[slot] = [Vector3::zeros(); CORNERS];
+        }
         if g != 0.0 {
-            self.corners[slot % SLOTS][usize::from(corner) % CORNERS] += o.axis(k) * g;
+            self.corners[slot][usize::from(corner) % CORNERS] += o.axis(k) * g;
         }
     }
 }
@@ -389,7 +394,7 @@ fn finish<const H: usize>(done: &Waypoint, w: usize, gradient: Option<&mut [Join
     let Some(slot) = gradient.and_then(|g| g.get_mut(w)) else {
         return Ok(());
     };
-    *slot = if done.pulls.touched {
+    *slot = if done.pulls.touched != 0 {
         // Finite inputs whose volumes' gradients overflowed are an overflow, not bad input.
         waypoint_gradient(done).map_err(|e| match e {
             Error::NonFiniteGradient => Error::Overflow,
@@ -522,7 +527,10 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
             continue;
         }
         let (pa, pb) = (ba.pose.translation, bb.pose.translation);
-        let radius = 0.5 * libm::sqrtf((pa - pb).norm_squared()) + 1.732_051 * ba.radius.max(bb.radius);
+        // |pa − pb|₁ ≥ |pa − pb|: a looser ball with no square root (this runs per box and
+        // segment), which only lets a few more pairs through to the exact volume.
+        let d = pa - pb;
+        let radius = 0.5 * (d.x.abs() + d.y.abs() + d.z.abs()) + 1.732_051 * ba.radius.max(bb.radius);
         let mid = (pa + pb) * 0.5;
         let r = Aabb {
             min: mid - Vector3::repeat(radius),
@@ -576,7 +584,7 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
 fn waypoint_gradient(w: &Waypoint) -> Result<Joints<f32>, Error> {
     let mut cot = Cotangent::new();
     for (s, (pulls, b)) in w.pulls.corners.iter().zip(w.boxes.iter()).enumerate() {
-        if !b.active {
+        if !b.active || w.pulls.touched & (1 << s) == 0 {
             continue;
         }
         let frame = PANDA.bodies.get(s).map_or(HAND_FRAME, |body| body.frame);
