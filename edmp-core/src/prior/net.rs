@@ -443,18 +443,17 @@ fn conv_tile<const CO: usize, const K: usize>(
     cin: usize,
 ) -> [[f32; TILE]; CO] {
     let mut acc = [[0.0f32; TILE]; CO];
-    for ci in 0..cin {
-        let Some(x_row) = input.get(ci * row..) else { break };
+    // Per input channel: its `K · CO` weights and the `TILE + K − 1` inputs the tile reads, as
+    // slices of exactly that length, so the taps below index them with no checks.
+    for (ci, w) in weights.chunks_exact(K * CO).take(cin).enumerate() {
+        let Some(x) = input.get(ci * row..).and_then(|r| r.get(..TILE + K - 1)) else {
+            break;
+        };
         for kk in 0..K {
-            let Some(x) = x_row.get(kk..).and_then(|r| r.first_chunk::<TILE>()) else {
-                break;
-            };
-            let Some(w) = weights.get((ci * K + kk) * CO..).and_then(|r| r.first_chunk::<CO>()) else {
-                break;
-            };
-            for (acc_c, w_c) in acc.iter_mut().zip(w) {
-                for (a, v) in acc_c.iter_mut().zip(x) {
-                    *a += w_c * v;
+            for (c, acc_c) in acc.iter_mut().enumerate() {
+                let w_c = w[kk * CO + c];
+                for (p, a) in acc_c.iter_mut().enumerate() {
+                    *a += w_c * x[kk + p];
                 }
             }
         }
