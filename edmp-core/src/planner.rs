@@ -838,6 +838,27 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(miri, ignore = "the exact checker over a batch: too slow under Miri")]
+    fn where_the_judge_starts_its_walk_changes_no_verdict() {
+        let scene = wall_scene();
+        let cfg = PlanConfig {
+            global: None,
+            ..config()
+        };
+        let plain = select(&scene, &START, &GOAL, &cfg, mixed_batch(), &RowChecks::NONE).unwrap();
+        for first in [0u16, 7, 24, 48, 49, 200] {
+            let hinted = RowChecks {
+                free: [false; 12],
+                touched: [Some(first); 12],
+            };
+            let judged = select(&scene, &START, &GOAL, &cfg, mixed_batch(), &hinted).unwrap();
+            assert_eq!(judged.verdicts, plain.verdicts, "walks from segment {first}");
+            assert_eq!(judged.best, plain.best);
+        }
+        assert!(plain.verdicts[..6].iter().all(|v| !v.free) && plain.verdicts[6..].iter().all(|v| v.free));
+    }
+
+    #[test]
     #[cfg_attr(miri, ignore = "refinement steps over a batch: too slow under Miri")]
     fn the_refinement_stops_on_the_checkers_word_and_keeps_certified_rows() {
         let scene = wall_scene();
