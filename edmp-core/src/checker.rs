@@ -416,13 +416,17 @@ pub fn check_trajectory<const H: usize, const N: usize>(
             first_contact: None,
         });
     };
-    check_path(scene, trajectory, [first, last], config, stop_at_first, 0)
+    check_path(scene, trajectory, [first, last], config, stop_at_first, None)
 }
 
-/// [`check_trajectory`] stopping at the first contact, walking the segments from `first`
-/// (then on to the last and round to segment 0): where a path touched at its last check it
-/// most likely touches again, and a contact found there ends the walk at once. Whether the path
-/// is free does not depend on the order; which contact is reported first does.
+/// [`check_trajectory`] stopping at the first contact, in the order where a candidate of the
+/// refinement most likely touches: every state of segment `first` (where it touched at its
+/// last check), then the other waypoints, then the states between them (segments from `first`
+/// on and round to 0 in each pass). A colliding candidate mostly touches again where it did or
+/// at some waypoint, which ends the walk early; a free one costs the same states. The states
+/// are the same as [`check_trajectory`]'s; which contact is reported first differs, and so
+/// may, rarely, the verdict on a state GJK's carried direction decides at the margin (each
+/// "free" is certified either way).
 pub fn check_trajectory_from<const H: usize, const N: usize>(
     scene: &Scene<N>,
     trajectory: &[Joints<f32>; H],
@@ -436,7 +440,7 @@ pub fn check_trajectory_from<const H: usize, const N: usize>(
             first_contact: None,
         });
     };
-    check_path(scene, trajectory, [start, end], config, true, first)
+    check_path(scene, trajectory, [start, end], config, true, Some(first))
 }
 
 /// Checks the straight segment `a → b` (both ends included) of a path whose ends are `ends`
@@ -494,7 +498,7 @@ fn check_path<const N: usize>(
     ends: [&Joints<f32>; 2],
     config: &CheckConfig,
     stop_at_first: bool,
-    first: usize,
+    first: Option<usize>,
 ) -> Result<TrajectoryReport, Error> {
     let mut prepared = Prepared::new(scene, config)?;
     let mut report = TrajectoryReport {
@@ -509,13 +513,12 @@ fn check_path<const N: usize>(
         }
     }
     let count = trajectory.len();
-    let first = if first < count { first } else { 0 };
-    // When only the verdict is asked for, three passes: every state of segment `first` (where a
-    // candidate touched at its last check), then the other waypoints, then the states between
-    // them. A colliding candidate mostly touches again where it did or at some waypoint, which
-    // ends the walk before the states between the others are checked; a free one costs the same
-    // states either way. Counting every colliding state is one walk in order.
-    let passes = if stop_at_first { 3 } else { 1 };
+    // `None`: one walk in order. `Some`: [`check_trajectory_from`]'s three passes.
+    let (passes, first) = match first {
+        Some(f) if stop_at_first => (3, if f < count { f } else { 0 }),
+        _ => (1, 0),
+    };
+    let walk = passes == 1;
     for pass in 0..passes {
         for segment in (first..count).chain(0..first) {
             let Some(q) = trajectory.get(segment) else { continue };
@@ -524,11 +527,11 @@ fn check_path<const N: usize>(
                 Some(b) => segment_steps(q, b, config.max_step)?,
                 None => 1,
             };
-            let range = match (stop_at_first, pass, segment == first) {
-                (false, ..) => 0..steps,
-                (true, 0, true) => 0..steps,
-                (true, 1, false) => 0..1,
-                (true, 2, false) => 1..steps,
+            let range = match (walk, pass, segment == first) {
+                (true, ..) => 0..steps,
+                (false, 0, true) => 0..steps,
+                (false, 1, false) => 0..1,
+                (false, 2, false) => 1..steps,
                 _ => 0..0,
             };
             for step in range {
