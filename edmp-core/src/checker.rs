@@ -409,14 +409,7 @@ pub fn check_trajectory<const H: usize, const N: usize>(
     config: &CheckConfig,
     stop_at_first: bool,
 ) -> Result<TrajectoryReport, Error> {
-    let (Some(first), Some(last)) = (trajectory.first(), trajectory.last()) else {
-        return Ok(TrajectoryReport {
-            states: 0,
-            colliding_states: 0,
-            first_contact: None,
-        });
-    };
-    check_path(scene, trajectory, [first, last], config, stop_at_first, None)
+    check_between_own_ends(scene, trajectory, config, stop_at_first, None)
 }
 
 /// [`check_trajectory`] stopping at the first contact, in the order where a candidate of the
@@ -433,6 +426,17 @@ pub fn check_trajectory_from<const H: usize, const N: usize>(
     config: &CheckConfig,
     first: usize,
 ) -> Result<TrajectoryReport, Error> {
+    check_between_own_ends(scene, trajectory, config, true, Some(first))
+}
+
+/// [`check_path`] of a whole trajectory, whose first and last waypoints are the ends.
+fn check_between_own_ends<const N: usize>(
+    scene: &Scene<N>,
+    trajectory: &[Joints<f32>],
+    config: &CheckConfig,
+    stop_at_first: bool,
+    first: Option<usize>,
+) -> Result<TrajectoryReport, Error> {
     let (Some(start), Some(end)) = (trajectory.first(), trajectory.last()) else {
         return Ok(TrajectoryReport {
             states: 0,
@@ -440,7 +444,7 @@ pub fn check_trajectory_from<const H: usize, const N: usize>(
             first_contact: None,
         });
     };
-    check_path(scene, trajectory, [start, end], config, true, Some(first))
+    check_path(scene, trajectory, [start, end], config, stop_at_first, first)
 }
 
 /// Checks the straight segment `a → b` (both ends included) of a path whose ends are `ends`

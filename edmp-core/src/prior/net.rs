@@ -435,25 +435,40 @@ type WeightTile = [f32; MAX_TAPS * TILE_CHANNELS];
 /// in registers. `weights` holds the `CO` channels' weights as f32, `[ci][tap][c]`; `input`
 /// starts at the first tap of the tile's first position in channel 0. Each output sums over
 /// input channel, then tap: the order every path keeps.
+/// The taps [`conv_tile`] runs, `K` either way. On x86-64 read from the layer at run time: a
+/// loop the compiler does not unroll, so that each tap's window is one unaligned load, where
+/// the unrolled taps were stitched from overlapping loads with shuffles (network 385 → 328 ×
+/// 10⁶ instructions per plan). A Cortex-M has no vectors to stitch and keeps the constant.
+#[cfg(not(target_arch = "arm"))]
+fn taps_of<const K: usize>(conv: &Conv) -> usize {
+    conv.k.min(K)
+}
+#[cfg(target_arch = "arm")]
+fn taps_of<const K: usize>(_: &Conv) -> usize {
+    K
+}
+
 #[inline(always)]
 fn conv_tile<const CO: usize, const K: usize>(
     weights: &[f32],
     input: &[f32],
     row: usize,
     cin: usize,
+    taps: usize,
 ) -> [[f32; TILE]; CO] {
     let mut acc = [[0.0f32; TILE]; CO];
-    // Per input channel: its `K · CO` weights and the `TILE + K − 1` inputs the tile reads, as
-    // slices of exactly that length, so the taps below index them with no checks.
+    // Per input channel: its `K · CO` weights, then tap by tap a window of `TILE` inputs.
     for (ci, w) in weights.chunks_exact(K * CO).take(cin).enumerate() {
-        let Some(x) = input.get(ci * row..).and_then(|r| r.get(..TILE + K - 1)) else {
+        let Some(x_row) = input.get(ci * row..) else {
             break;
         };
-        for kk in 0..K {
-            for (c, acc_c) in acc.iter_mut().enumerate() {
-                let w_c = w[kk * CO + c];
-                for (p, a) in acc_c.iter_mut().enumerate() {
-                    *a += w_c * x[kk + p];
+        for (kk, w_k) in w.chunks_exact(CO).take(taps).enumerate() {
+            let Some(x) = x_row.get(kk..).and_then(|r| r.first_chunk::<TILE>()) else {
+                break;
+            };
+            for (acc_c, w_c) in acc.iter_mut().zip(w_k) {
+                for (a, v) in acc_c.iter_mut().zip(x) {
+                    *a += w_c * v;
                 }
             }
         }
@@ -526,7 +541,13 @@ fn conv_rows<const CO: usize, const K: usize>(
     let outputs = lay.batch * seg - 2 * PAD;
     let mut q0 = 0;
     while q0 < outputs {
-        let acc = conv_tile::<CO, K>(weights, input.get(shift + q0..).unwrap_or(&[]), row, conv.cin);
+        let acc = conv_tile::<CO, K>(
+            weights,
+            input.get(shift + q0..).unwrap_or(&[]),
+            row,
+            conv.cin,
+            taps_of::<K>(conv),
+        );
         // Keep the tile's data positions: trajectory b's run [b·seg + PAD, b·seg + PAD + len).
         let (lo, hi) = (q0 + PAD, (q0 + PAD + TILE).min(outputs + PAD));
         let mut b = lo / seg;
