@@ -157,7 +157,8 @@ fn body_level(body: usize) -> u8 {
         .map_or_else(|| level(HAND_FRAME), |b| level(b.frame))
 }
 
-fn moves(body: usize) -> bool {
+/// Whether shape `body` (a robot body, or the held object at `BODIES`) moves with the joints.
+pub(crate) fn moves(body: usize) -> bool {
     body >= BODIES || PANDA.bodies[body].frame != 0
 }
 

@@ -31,6 +31,11 @@ pub enum CostKind {
     Intersection,
     /// Swept volume over segments ("sv").
     Swept,
+    /// The exact clearance of the checker's hulls from the true obstacles over the interior
+    /// waypoints, within the inflation's clearance ([`crate::clearance`]; not EDMP's: an
+    /// ablation of the stronger local optimizer). Expansion, cylinder boxes and frame do not
+    /// apply.
+    Clearance,
 }
 
 /// Everything that selects one cost evaluation.
@@ -324,6 +329,9 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     let Inflation { clearance, expansion } = config.inflation;
     if !(clearance.is_finite() && expansion.is_finite() && clearance >= 0.0 && expansion >= 0.0) {
         return Err(Error::BadParameter);
+    }
+    if config.kind == CostKind::Clearance {
+        return crate::clearance::trajectory_cost(scene, trajectory, clearance, gradient);
     }
     // Refuse bad input before any work, so the error names it whatever comes later.
     for q in trajectory {

@@ -159,6 +159,7 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
         goal,
         &mut plan.paths,
         &mut work.grads,
+        &mut work.eps,
         guides,
         global.refine,
         config,

@@ -13,7 +13,7 @@ use crate::error::Error;
 use crate::geometry::{BoxFrame, CylinderBox};
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::robot::PANDA;
+use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
 
 /// Applies every row's guide once at diffusion step `t`, no joint of a waypoint moving more
@@ -29,7 +29,6 @@ use crate::scene::Scene;
 /// be the same no-op: skipping it saves the work and changes no bit. Clear the flags whenever
 /// `t` (or the scene) changes. Any other length is [`Error::BadParameter`].
 #[allow(clippy::too_many_arguments)]
-#[inline(never)] // one symbol for profiles (benchmarks/stage_instructions.py); it is large anyway
 pub fn guide_step<const H: usize, const N: usize>(
     scene: &Scene<N>,
     rows: &mut [[Joints<f32>; H]],
@@ -41,6 +40,76 @@ pub fn guide_step<const H: usize, const N: usize>(
     frame: BoxFrame,
     settled: &mut [bool],
 ) -> Result<(), Error> {
+    let rule = StepRule {
+        step_limit,
+        cylinder,
+        frame,
+    };
+    step_rows(scene, rows, grads, guides, t, &rule, settled, None)
+}
+
+/// How [`guide_step`] moves rows: the per-joint step limit and how the costs box things.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepRule {
+    /// Largest move of one joint of one waypoint, radians.
+    pub step_limit: f32,
+    /// How cylinders are boxed.
+    pub cylinder: CylinderBox,
+    /// The frame the costs box each pair in.
+    pub frame: BoxFrame,
+}
+
+/// Step-size control for gradient steps at a fixed `t` (the refinement; an ablation, not
+/// EDMP's, docs/benchmark.md): each guide remembers its rows where its cost was last lowest.
+/// A step after which the cost rose is undone and the guide's step halves; a guide whose step
+/// has halved [`MIN_STEP_SCALE`]'s worth is settled (it has converged as far as these steps
+/// can tell). EDMP's fixed normalized steps never converge: near a minimum they bounce across
+/// it at full length.
+#[derive(Debug)]
+pub struct StepControl<'a, const H: usize> {
+    /// Each row where its guide's cost was last lowest (written by the control).
+    pub saved: &'a mut [[Joints<f32>; H]],
+    /// Each guide's cost, summed over its rows, at `saved` (`+∞`: nothing accepted yet).
+    pub best: &'a mut [f32],
+    /// Each guide's step multiplier (1: the guide's own step).
+    pub scale: &'a mut [f32],
+}
+
+/// The step multiplier below which [`StepControl`] settles a guide.
+pub const MIN_STEP_SCALE: f32 = 1.0 / 64.0;
+
+/// [`guide_step`] with step-size control ([`StepControl`], one entry per guide in `best` and
+/// `scale`, one saved row per row; other lengths are [`Error::BadParameter`]).
+#[allow(clippy::too_many_arguments)]
+pub fn guide_step_controlled<const H: usize, const N: usize>(
+    scene: &Scene<N>,
+    rows: &mut [[Joints<f32>; H]],
+    grads: &mut [[Joints<f32>; H]],
+    guides: &[Guide],
+    t: u16,
+    rule: &StepRule,
+    settled: &mut [bool],
+    control: &mut StepControl<'_, H>,
+) -> Result<(), Error> {
+    if control.saved.len() != rows.len() || control.best.len() != guides.len() || control.scale.len() != guides.len() {
+        return Err(Error::BadParameter);
+    }
+    step_rows(scene, rows, grads, guides, t, rule, settled, Some(control))
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(never)] // one symbol for profiles (benchmarks/stage_instructions.py); it is large anyway
+fn step_rows<const H: usize, const N: usize>(
+    scene: &Scene<N>,
+    rows: &mut [[Joints<f32>; H]],
+    grads: &mut [[Joints<f32>; H]],
+    guides: &[Guide],
+    t: u16,
+    rule: &StepRule,
+    settled: &mut [bool],
+    mut control: Option<&mut StepControl<'_, H>>,
+) -> Result<(), Error> {
+    let step_limit = rule.step_limit;
     if step_limit.is_nan() || step_limit <= 0.0 {
         return Err(Error::BadParameter);
     }
@@ -48,6 +117,9 @@ pub fn guide_step<const H: usize, const N: usize>(
         return Err(Error::BadParameter);
     }
     if !settled.is_empty() && settled.len() != guides.len() {
+        return Err(Error::BadParameter);
+    }
+    if guides.iter().any(|g| !(g.smooth.is_finite() && g.smooth >= 0.0)) {
         return Err(Error::BadParameter);
     }
     let per_guide = rows.len() / guides.len();
@@ -66,16 +138,42 @@ pub fn guide_step<const H: usize, const N: usize>(
         let config = CostConfig {
             kind: guide.cost,
             inflation: guide.inflation(t),
-            cylinder,
-            frame,
+            cylinder: rule.cylinder,
+            frame: rule.frame,
         };
         let mut norm2 = 0.0f32;
+        let mut cost = 0.0f32;
         for (row, grad) in rows.iter().zip(grads.iter_mut()) {
             let clipped = row.map(|q| core::array::from_fn(|j| q[j].clamp(PANDA.hard_lower[j], PANDA.hard_upper[j])));
-            trajectory_cost(scene, &clipped, &config, Some(grad))?;
+            cost += trajectory_cost(scene, &clipped, &config, Some(grad))?;
             norm2 += grad[1..H - 1].iter().flatten().map(|g| g * g).sum::<f32>();
         }
-        let step = guide.step.at(t);
+        let mut multiplier = 1.0f32;
+        if let Some(c) = control.as_deref_mut() {
+            let (Some(best), Some(scale)) = (c.best.get_mut(g), c.scale.get_mut(g)) else {
+                return Err(Error::BadParameter);
+            };
+            let saved = c.saved.chunks_mut(per_guide).nth(g).unwrap_or(&mut []);
+            if cost > *best {
+                // The last step made things worse: undo it and try half as far next time.
+                for (row, kept) in rows.iter_mut().zip(saved.iter()) {
+                    *row = *kept;
+                }
+                *scale *= 0.5;
+                if *scale < MIN_STEP_SCALE
+                    && let Some(flag) = settled.get_mut(g)
+                {
+                    *flag = true;
+                }
+                continue;
+            }
+            *best = cost;
+            for (kept, row) in saved.iter_mut().zip(rows.iter()) {
+                *kept = *row;
+            }
+            multiplier = *scale;
+        }
+        let step = guide.step.at(t) * multiplier;
         let scale = if !guide.normalize {
             step
         } else if norm2 > 0.0 && norm2.is_finite() {
@@ -88,11 +186,20 @@ pub fn guide_step<const H: usize, const N: usize>(
         } else {
             return Err(Error::Overflow);
         };
+        let smooth = guide.smooth * multiplier;
         let mut moved = false;
         for (row, grad) in rows.iter_mut().zip(grads.iter()) {
-            for (q, gq) in row[1..H - 1].iter_mut().zip(&grad[1..H - 1]) {
-                for (qj, gj) in q.iter_mut().zip(gq) {
-                    let next = *qj - (scale * gj).clamp(-step_limit, step_limit);
+            // The smoothness term acts only where the collision cost pulls: a row it leaves
+            // alone stays put (and its guide can settle).
+            let pulled = smooth > 0.0 && grad[1..H - 1].iter().flatten().any(|&v| v != 0.0);
+            let bend = if pulled {
+                bending_gradient(row)
+            } else {
+                [[0.0; JOINTS]; H]
+            };
+            for ((q, gq), bq) in row[1..H - 1].iter_mut().zip(&grad[1..H - 1]).zip(&bend[1..H - 1]) {
+                for ((qj, gj), bj) in q.iter_mut().zip(gq).zip(bq) {
+                    let next = *qj - (scale * gj + smooth * bj).clamp(-step_limit, step_limit);
                     moved |= next.to_bits() != qj.to_bits();
                     *qj = next;
                 }
@@ -106,6 +213,23 @@ pub fn guide_step<const H: usize, const N: usize>(
         }
     }
     Ok(())
+}
+
+/// The gradient of the bending energy `½ Σ_{i=1}^{H−2} |q_{i−1} − 2 q_i + q_{i+1}|²` with respect
+/// to every waypoint (the ends' entries are not used): the smoothness term of a guide
+/// ([`Guide::smooth`]). An explicit step of weight `w` on it is stable for `w < 1/8`.
+pub fn bending_gradient<const H: usize>(row: &[Joints<f32>; H]) -> [Joints<f32>; H] {
+    let mut accel = [[0.0f32; JOINTS]; H];
+    for i in 1..H.saturating_sub(1) {
+        accel[i] = core::array::from_fn(|j| row[i - 1][j] - 2.0 * row[i][j] + row[i + 1][j]);
+    }
+    let mut grad = [[0.0f32; JOINTS]; H];
+    for (k, gk) in grad.iter_mut().enumerate() {
+        let at = |i: usize| accel.get(i).copied().unwrap_or([0.0; JOINTS]);
+        let (before, here, after) = (k.checked_sub(1).map_or([0.0; JOINTS], at), at(k), at(k + 1));
+        *gk = core::array::from_fn(|j| before[j] - 2.0 * here[j] + after[j]);
+    }
+    grad
 }
 
 #[cfg(test)]
@@ -214,6 +338,7 @@ mod tests {
             expansion: crate::guides::Schedule::Constant(0.0),
             normalize: true,
             step: crate::guides::Schedule::Constant(0.01),
+            smooth: 0.0,
         };
         let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
         let b = [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
@@ -413,5 +538,139 @@ mod tests {
             );
             assert_eq!(err, Err(Error::BadParameter));
         }
+    }
+
+    fn bending(x: &[Joints<f32>; H]) -> f32 {
+        (1..H - 1)
+            .map(|i| {
+                (0..7)
+                    .map(|j| (x[i - 1][j] - 2.0 * x[i][j] + x[i + 1][j]).powi(2))
+                    .sum::<f32>()
+            })
+            .sum::<f32>()
+            * 0.5
+    }
+
+    #[test]
+    fn the_bending_gradient_matches_finite_differences() {
+        let x: [Joints<f32>; H] = core::array::from_fn(|w| {
+            core::array::from_fn(|j| 0.3 * libm::sinf(0.7 * w as f32 + j as f32) + 0.01 * (w * w) as f32)
+        });
+        let g = bending_gradient(&x);
+        for w in 1..H - 1 {
+            for j in 0..7 {
+                let h = 1e-2;
+                let (mut up, mut down) = (x, x);
+                up[w][j] += h;
+                down[w][j] -= h;
+                let fd = (bending(&up) - bending(&down)) / (2.0 * h);
+                assert!(
+                    (fd - g[w][j]).abs() <= 1e-3 * fd.abs().max(1.0),
+                    "w {w} j {j}: {fd} vs {}",
+                    g[w][j]
+                );
+            }
+        }
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "guidance steps over a batch: too slow under Miri")]
+    fn a_smoothness_term_bends_the_path_less_and_leaves_free_rows_alone() {
+        let scene = scene();
+        let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let b = [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let guide = EDMP_GUIDES[6];
+        let run = |smooth: f32, scene: &Scene<4>| {
+            let mut rows = [line(a, b)];
+            let mut grads = [[[0.0; 7]; H]];
+            let g = Guide { smooth, ..guide };
+            for _ in 0..20 {
+                guide_step(
+                    scene,
+                    &mut rows,
+                    &mut grads,
+                    &[g],
+                    1,
+                    0.1,
+                    CylinderBox::Enclosing,
+                    BoxFrame::Obstacle,
+                    &mut [],
+                )
+                .unwrap();
+            }
+            rows[0]
+        };
+        let (rough, smooth) = (run(0.0, &scene), run(0.1, &scene));
+        assert!(
+            bending(&smooth) < bending(&rough),
+            "{} vs {}",
+            bending(&smooth),
+            bending(&rough)
+        );
+        // Nothing to avoid: the smoothness term alone does not move a row.
+        assert_eq!(run(0.1, &Scene::new()), line(a, b));
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "guidance steps over a batch: too slow under Miri")]
+    fn step_control_never_keeps_a_worse_row_and_settles_within_its_bound() {
+        let scene = scene();
+        let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let b = [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let guides = [EDMP_GUIDES[0], EDMP_GUIDES[6]];
+        let rule = StepRule {
+            step_limit: 0.1,
+            cylinder: CylinderBox::Enclosing,
+            frame: BoxFrame::Obstacle,
+        };
+        let mut rows = [line(a, b); 2];
+        let mut grads = [[[0.0; 7]; H]; 2];
+        let mut saved = rows;
+        let (mut best, mut scale) = ([f32::INFINITY; 2], [1.0; 2]);
+        let mut settled = [false; 2];
+        let mut last = [f32::INFINITY; 2];
+        let mut steps = 0;
+        while !settled.iter().all(|&s| s) {
+            let mut control = StepControl {
+                saved: &mut saved,
+                best: &mut best,
+                scale: &mut scale,
+            };
+            guide_step_controlled(
+                &scene,
+                &mut rows,
+                &mut grads,
+                &guides,
+                1,
+                &rule,
+                &mut settled,
+                &mut control,
+            )
+            .unwrap();
+            for g in 0..2 {
+                assert!(best[g] <= last[g], "guide {g}: {} after {}", best[g], last[g]);
+                last[g] = best[g];
+            }
+            steps += 1;
+            // Each guide halves at most 7 times before it settles; between halvings it only
+            // descends, which ends too (no test runs forever: the bound is generous).
+            assert!(steps < 2000, "still stepping");
+        }
+        assert!(scale.iter().any(|&s| s < 1.0), "some step was undone");
+        let err = guide_step_controlled(
+            &scene,
+            &mut rows,
+            &mut grads,
+            &guides,
+            1,
+            &rule,
+            &mut settled,
+            &mut StepControl {
+                saved: &mut saved[..1],
+                best: &mut best,
+                scale: &mut scale,
+            },
+        );
+        assert_eq!(err, Err(Error::BadParameter));
     }
 }

@@ -94,6 +94,10 @@ pub struct Guide {
     pub normalize: bool,
     /// Step size s(t): the interior waypoints move by −s(t)·gradient.
     pub step: Schedule,
+    /// Weight of the smoothness term: where the cost pulls a row, its waypoints also move by
+    /// `−smooth·∇½Σ|q_{i−1} − 2q_i + q_{i+1}|²` ([`crate::guidance::bending_gradient`]), so that
+    /// the guide does not buy clearance with jerk. 0 in EDMP's table (an ablation; below 1/8).
+    pub smooth: f32,
 }
 
 impl Guide {
@@ -131,6 +135,7 @@ const fn iv(id: u8, clearance: Schedule) -> Guide {
         expansion: Schedule::Constant(0.0),
         normalize: false,
         step: VARYING,
+        smooth: 0.0,
     }
 }
 
@@ -142,6 +147,7 @@ const fn sv(id: u8, clearance: f32, expansion: Schedule, normalize: bool, step: 
         expansion,
         normalize,
         step,
+        smooth: 0.0,
     }
 }
 
@@ -163,6 +169,19 @@ pub const EDMP_GUIDES: [Guide; EDMP_GUIDE_COUNT] = [
     sv(18, 0.05, E18, true, Schedule::Constant(0.05)),
     sv(21, 0.05, E18, true, Schedule::Constant(0.10)),
 ];
+
+/// A guide on the exact clearance of the checker's hulls ([`CostKind::Clearance`]; not one of
+/// EDMP's): 3 cm of clearance, a normalized step of 0.05. The refinement's ablation
+/// ([`crate::planner::PlanConfig::refine_guide`]) gives it to every row.
+pub const CLEARANCE_GUIDE: Guide = Guide {
+    id: 30,
+    cost: CostKind::Clearance,
+    clearance: Schedule::Constant(0.03),
+    expansion: Schedule::Constant(0.0),
+    normalize: true,
+    step: Schedule::Constant(0.05),
+    smooth: 0.0,
+};
 
 #[cfg(test)]
 mod tests {

@@ -19,6 +19,7 @@
 extern crate std;
 
 pub mod checker;
+pub mod clearance;
 pub mod convex;
 pub mod cost;
 pub mod error;

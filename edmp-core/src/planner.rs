@@ -16,7 +16,7 @@ use crate::cost::{CostConfig, CostKind, trajectory_cost};
 use crate::error::Error;
 use crate::geometry::{BoxFrame, CylinderBox, Inflation};
 use crate::global::{GlobalConfig, SearchReport, Stage, rescue};
-use crate::guidance::guide_step;
+use crate::guidance::{StepControl, StepRule, guide_step, guide_step_controlled};
 use crate::guides::Guide;
 use crate::kinematics::Joints;
 use crate::prior::{
@@ -92,6 +92,12 @@ pub struct PlanConfig {
     /// Ending the refinement early on the exact checker's word ([`RefineStop`]; `None`: every
     /// refinement step runs, as in EDMP's fixed schedule).
     pub refine_stop: Option<RefineStop>,
+    /// The guide every row follows in the refinement (`None`: each row its own, as EDMP; e.g.
+    /// [`crate::guides::CLEARANCE_GUIDE`], the exact-clearance ablation, docs/benchmark.md).
+    pub refine_guide: Option<Guide>,
+    /// Step-size control in the refinement ([`StepControl`]: a step that raised a guide's cost
+    /// is undone and its step halves; `false`: EDMP's fixed steps). An ablation.
+    pub step_control: bool,
 }
 
 /// When the refinement may end early: the exact checker certifies rows free (judged as
@@ -184,6 +190,8 @@ impl PlanConfig {
         global: Some(GlobalConfig::DEFAULT),
         shortcut: Some(ShortcutConfig::DEFAULT),
         refine_stop: Some(RefineStop::DEFAULT),
+        refine_guide: None,
+        step_control: false,
     };
 }
 
@@ -409,8 +417,10 @@ fn guide_once<const B: usize, const N: usize>(
     )
 }
 
-/// The refinement: `steps` gradient steps of every row's guide at t = 1, ended early by
+/// The refinement: `steps` gradient steps of every row's guide at t = 1 (or of
+/// `config.refine_guide`, with step-size control if `config.step_control`), ended early by
 /// `config.refine_stop` ([`RefineStop`]); shared by the first stage and the global stage.
+/// `saved` is working memory for the step-size control.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn refine<const B: usize, const N: usize>(
     scene: &Scene<N>,
@@ -418,6 +428,7 @@ pub(crate) fn refine<const B: usize, const N: usize>(
     goal: &Joints<f32>,
     paths: &mut [Path; B],
     grads: &mut [Path; B],
+    saved: &mut [Path; B],
     guides: &[Guide],
     steps: u8,
     config: &PlanConfig,
@@ -428,17 +439,35 @@ pub(crate) fn refine<const B: usize, const N: usize>(
         free: certified,
         touched,
     } = checks;
-    let Some(stop) = config.refine_stop else {
-        return guide_steps(scene, paths, grads, guides, 1, steps, config);
+    let every_row: [Guide; B];
+    let guides = match config.refine_guide {
+        Some(g) => {
+            every_row = [g; B];
+            &every_row[..]
+        }
+        None => guides,
     };
-    if stop.every == 0 || stop.free == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) {
+    if guides.is_empty() || !B.is_multiple_of(guides.len()) {
+        return Err(Error::BadParameter);
+    }
+    if let Some(stop) = config.refine_stop
+        && (stop.every == 0 || stop.free == 0)
+    {
         return Err(Error::BadParameter);
     }
     let per_guide = B / guides.len();
     let mut settled = [false; B];
     let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
+    let (mut best, mut scale) = ([f32::INFINITY; B], [1.0f32; B]);
+    let rule = StepRule {
+        step_limit: config.step_limit,
+        cylinder: config.cylinder,
+        frame: config.frame,
+    };
     for s in 0..steps {
-        if s % stop.every == 0 {
+        if let Some(stop) = config.refine_stop
+            && s % stop.every == 0
+        {
             let rows = paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut());
             for ((x, done), touched) in rows.filter(|((_, done), _)| !**done) {
                 let mut judged = *x;
@@ -460,7 +489,16 @@ pub(crate) fn refine<const B: usize, const N: usize>(
                 }
             }
         }
-        guide_once(scene, paths, grads, guides, 1, config, settled)?;
+        if config.step_control {
+            let mut control = StepControl {
+                saved: &mut saved[..],
+                best: best.get_mut(..guides.len()).unwrap_or(&mut []),
+                scale: scale.get_mut(..guides.len()).unwrap_or(&mut []),
+            };
+            guide_step_controlled(scene, paths, grads, guides, 1, &rule, settled, &mut control)?;
+        } else {
+            guide_once(scene, paths, grads, guides, 1, config, settled)?;
+        }
         if settled.iter().all(|&s| s) {
             break;
         }
@@ -531,6 +569,7 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
         goal,
         paths,
         &mut work.grads,
+        &mut work.eps,
         guides,
         config.refine,
         config,
@@ -671,6 +710,8 @@ mod tests {
             global: None,
             shortcut: None,
             refine_stop: None,
+            refine_guide: None,
+            step_control: false,
         }
     }
 
@@ -882,6 +923,7 @@ mod tests {
             };
             let mut paths = batch;
             let mut grads = [[[0.0; JOINTS]; HORIZON]; 12];
+            let mut saved = grads;
             let mut checks = RowChecks {
                 free: [true; 12],
                 touched: [Some(3); 12],
@@ -892,6 +934,7 @@ mod tests {
                 &GOAL,
                 &mut paths,
                 &mut grads,
+                &mut saved,
                 &EDMP_GUIDES,
                 steps,
                 &cfg,

@@ -151,7 +151,7 @@ fn label(args: &Args, guides: &[u8]) -> String {
 
 fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
     let parsed = parse_problem(text).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
-    let guides = chosen_guides(&args.guides)?;
+    let guides = args.tuning.guides(&args.guides)?;
     let config = args.tuning.config()?;
     let planned = plan_problem(&parsed, &guides, &config, args.seed)?;
     let plan = &planned.plan;

@@ -9,7 +9,7 @@ use crate::timed::{TimedArgs, TimedRequest, trajectory_document};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{BoxFrame, Inflation};
 use edmp_core::global::GlobalConfig;
-use edmp_core::guides::{EDMP_GUIDES, Guide};
+use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
     PlanConfig, RefineStop, Workspace, denoise, finish, polish, select,
@@ -101,9 +101,36 @@ pub struct Tuning {
     /// Global stage: nodes per search tree (the host holds at most 4096).
     #[arg(long, default_value_t = SearchConfig::DEFAULT.max_nodes)]
     search_nodes: u16,
+    /// Weight of a smoothness term in every guide's step (the bending energy of the path;
+    /// 0: EDMP's guides; below 0.125). An ablation (docs/benchmark.md).
+    #[arg(long, default_value_t = 0.0)]
+    smooth: f32,
+    /// Step-size control in the refinement: a step that raised a guide's cost is undone and
+    /// its step halves (default: EDMP's fixed steps). An ablation.
+    #[arg(long)]
+    step_control: bool,
+    /// Refine every row with the exact-clearance guide (the checker's hulls against the true
+    /// obstacles, 3 cm) instead of its own guide. An ablation.
+    #[arg(long)]
+    refine_clearance: bool,
 }
 
 impl Tuning {
+    /// The guides named by `ids` ([`chosen_guides`]) with this tuning's smoothness weight.
+    pub fn guides(&self, ids: &[u8]) -> Result<Vec<Guide>, Failure> {
+        if !(self.smooth.is_finite() && (0.0..0.125).contains(&self.smooth)) {
+            return Err(Failure::Input(format!(
+                "--smooth: {} outside 0 ≤ w < 0.125 (larger steps on the bending energy diverge)",
+                self.smooth
+            )));
+        }
+        let mut guides = chosen_guides(ids)?;
+        for g in &mut guides {
+            g.smooth = self.smooth;
+        }
+        Ok(guides)
+    }
+
     /// The core's configuration, or the bad flag.
     pub fn config(&self) -> Result<PlanConfig, Failure> {
         let config = PlanConfig {
@@ -148,6 +175,8 @@ impl Tuning {
                 every: self.refine_check_every,
                 free: self.refine_stop_free,
             }),
+            refine_guide: self.refine_clearance.then_some(CLEARANCE_GUIDE),
+            step_control: self.step_control,
             ..PlanConfig::DEFAULT
         };
         if self.step_limit.is_nan() || self.step_limit <= 0.0 {
@@ -214,6 +243,16 @@ impl Tuning {
                 self.refine_check_every, self.refine_stop_free
             )
         };
+        let mut boxes = boxes;
+        if self.smooth > 0.0 {
+            boxes = format!("{boxes}, smoothness {}", self.smooth);
+        }
+        if self.step_control {
+            boxes = format!("{boxes}, step control");
+        }
+        if self.refine_clearance {
+            boxes = format!("{boxes}, clearance refinement");
+        }
         if self.ancestral {
             format!(
                 "ancestral K = 255, guidance on even t, {} refinement steps, {limit}{boxes}",
@@ -424,7 +463,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let text =
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
-    let guides = chosen_guides(&args.guides)?;
+    let guides = args.tuning.guides(&args.guides)?;
     let config = args.tuning.config()?;
     let timed = args.timed.request()?;
 

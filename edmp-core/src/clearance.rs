@@ -1,0 +1,259 @@
+//! The exact-clearance cost: how far the checker's own shapes come inside a clearance `c` of the
+//! true obstacles, with its hand-written adjoint.
+//!
+//! EDMP's costs compare boxes: every link's oriented box against every obstacle's inflated box.
+//! The checker judges something else, each moving body's convex hull (and the held object)
+//! against the exact primitives, so a row can be box-free and still touch, or touch in the boxes
+//! where the hulls pass (a 26 cm slot between bars is narrower than a forearm's box, not its
+//! hull). This cost measures what the checker measures: over the interior waypoints, bodies and
+//! obstacles, `Σ max(0, c − gap)²`, where `gap` is the signed separation of the hull and the
+//! obstacle along a direction `n`:
+//! - apart: `n` is the direction GJK finds from the obstacle to the hull, and `gap` the exact
+//!   lower bound along it (`gjk::gap_along`), the distance up to f32;
+//! - overlapping (GJK finds the origin inside): `n` is the best of the obstacle's face normals
+//!   (both ways) and the direction between the centres, and `gap < 0` the depth along it (the
+//!   shallowest way out that these directions offer).
+//!
+//! The gradient keeps `n` fixed (at the optimum direction the gap is stationary in it) and moves
+//! the hull's support point in `−n`, a point of its closest feature, rigidly with its frame: a
+//! force `−2 (c − gap) n` there ([`Cotangent::add_point`]), then the FK adjoint. Where a hull's
+//! face is the closest feature the moment is that of one of its vertices, not of the witness
+//! point: the joint gradient is then a descent direction, not the exact derivative.
+//!
+//! Work: one FK per interior waypoint, and one GJK per (body, obstacle) pair whose bounding balls
+//! come within `c`; nothing else. A guide with this cost is data like any other
+//! ([`crate::guides::CLEARANCE_GUIDE`]).
+
+use crate::checker::moves;
+use crate::convex::{Convex, Hull, Primitive};
+use crate::error::Error;
+use crate::gjk::{closest, gap_along};
+use crate::kinematics::{Cotangent, Joints, forward_with};
+use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
+use crate::scene::Scene;
+use nalgebra::Vector3;
+
+/// `Σ max(0, clearance − gap)²` over the interior waypoints of `trajectory`, every moving body's
+/// hull (and the held object) and every obstacle of `scene`; with `gradient`, its gradient with
+/// respect to every waypoint (zero at the ends). Non-finite joints and a negative or non-finite
+/// clearance are typed errors; so is an overflowing result.
+pub fn trajectory_cost<const H: usize, const N: usize>(
+    scene: &Scene<N>,
+    trajectory: &[Joints<f32>; H],
+    clearance: f32,
+    gradient: Option<&mut [Joints<f32>; H]>,
+) -> Result<f32, Error> {
+    if !(clearance.is_finite() && clearance >= 0.0) {
+        return Err(Error::BadParameter);
+    }
+    for q in trajectory {
+        if let Some(joint) = q.iter().position(|x| !x.is_finite()) {
+            return Err(Error::NonFiniteJoint { joint: joint as u8 });
+        }
+    }
+    let obstacles: [Primitive; N] = core::array::from_fn(|i| {
+        scene.obstacles().get(i).map_or(
+            Primitive::cuboid(&crate::kinematics::Pose::identity(), &Vector3::zeros()),
+            Primitive::obstacle,
+        )
+    });
+    let obstacles = obstacles.get(..scene.obstacles().len()).unwrap_or(&[]);
+    let mut reach = [0.0f32; N];
+    for (r, o) in reach.iter_mut().zip(obstacles) {
+        *r = o.bounding_radius() + clearance;
+    }
+    let mut radius = [0.0f32; BODIES];
+    for (r, body) in radius.iter_mut().zip(PANDA.bodies.iter()) {
+        *r = libm::sqrtf(body.half_extents.norm_squared());
+    }
+
+    let mut gradient = gradient;
+    if let Some(g) = gradient.as_deref_mut() {
+        g.fill([0.0; JOINTS]);
+    }
+    let mut total = 0.0f32;
+    for (w, q) in trajectory.iter().enumerate().take(H.saturating_sub(1)).skip(1) {
+        let k = forward_with(q, scene.gripper())?;
+        let mut cot = Cotangent::new();
+        let mut touched = false;
+        let mut pair = |shape: &dyn Convex, frame: usize, center: &Vector3<f32>, radius: f32| {
+            for (o, &reach) in obstacles.iter().zip(&reach) {
+                let limit = radius + reach;
+                if (center - o.center).norm_squared() > limit * limit {
+                    continue;
+                }
+                let (gap, n) = signed_gap(shape, o, &(center - o.center));
+                if gap >= clearance {
+                    continue;
+                }
+                let depth = clearance - gap;
+                total += depth * depth;
+                cot.add_point(frame, &shape.support(&-n), &(n * (-2.0 * depth)));
+                touched = true;
+            }
+        };
+        for b in (0..BODIES).filter(|&b| moves(b)) {
+            let frame = PANDA.bodies[b].frame.min(FRAMES - 1);
+            let hull = Hull {
+                pose: &k.frames[frame],
+                points: PANDA.hull(b),
+            };
+            pair(&hull, frame, &k.boxes[b].translation, radius[b]);
+        }
+        if let Some(h) = scene.held() {
+            let held = Primitive::attached(h, &k.frames[HAND_FRAME]);
+            pair(&held, HAND_FRAME, &held.center, held.bounding_radius());
+        }
+        if let Some(slot) = gradient.as_deref_mut().and_then(|g| g.get_mut(w))
+            && touched
+        {
+            *slot = k.joint_gradient(&cot).map_err(|e| match e {
+                Error::NonFiniteGradient => Error::Overflow,
+                other => other,
+            })?;
+        }
+    }
+    if total.is_finite() {
+        Ok(total)
+    } else {
+        Err(Error::Overflow)
+    }
+}
+
+/// The signed separation of `a` from `b` along a direction `n` (unit, from `b` towards `a`) and
+/// that direction: GJK's when they are apart, else the best of `b`'s face normals and the
+/// centres' direction `towards` (see the module docs).
+fn signed_gap(a: &dyn Convex, b: &Primitive, towards: &Vector3<f32>) -> (f32, Vector3<f32>) {
+    let a = &Dyn(a);
+    if let Some(v) = closest(a, b, towards) {
+        let len = libm::sqrtf(v.norm_squared());
+        if len > 0.0 && len.is_finite() {
+            let n = v / len;
+            return (gap_along(a, b, &n), n);
+        }
+    }
+    let mut best = (f32::NEG_INFINITY, Vector3::z());
+    let mut consider = |n: Vector3<f32>| {
+        let gap = gap_along(a, b, &n);
+        if gap > best.0 {
+            best = (gap, n);
+        }
+    };
+    let len = libm::sqrtf(towards.norm_squared());
+    if len > 0.0 && len.is_finite() {
+        consider(towards / len);
+    }
+    if let Some(normals) = b.face_normals() {
+        for n in normals.column_iter() {
+            consider(n.into_owned());
+            consider(-n);
+        }
+    }
+    best
+}
+
+/// A `dyn Convex` as a sized one, for GJK's generic functions.
+struct Dyn<'a>(&'a dyn Convex);
+
+impl Convex for Dyn<'_> {
+    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
+        self.0.support(d)
+    }
+
+    fn face_normals(&self) -> Option<nalgebra::Matrix3<f32>> {
+        self.0.face_normals()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Obstacle;
+
+    const H: usize = 6;
+
+    /// A wall in front of the robot, its face at x = 0.45.
+    fn wall() -> Scene<4> {
+        let mut s = Scene::new();
+        let o = Obstacle::cuboid([0.6, 0.0, 0.5], [0.3, 1.0, 1.0], [1.0, 0.0, 0.0, 0.0]);
+        s.push(o.unwrap()).unwrap();
+        s
+    }
+
+    fn reach(s: f32) -> [Joints<f32>; H] {
+        core::array::from_fn(|w| {
+            let a = s * w as f32 / (H - 1) as f32;
+            [0.1 * a, 0.2 + a, 0.05, -2.0 + 1.2 * a, 0.1, 1.8, 0.7]
+        })
+    }
+
+    #[test]
+    fn far_from_everything_the_cost_and_gradient_are_zero() {
+        let mut g = [[1.0; JOINTS]; H];
+        let c = trajectory_cost(&Scene::<4>::new(), &reach(1.0), 0.05, Some(&mut g)).unwrap();
+        assert_eq!(c, 0.0);
+        assert!(g.iter().flatten().all(|&x| x == 0.0));
+    }
+
+    #[test]
+    fn the_gradient_matches_finite_differences_and_descends() {
+        let scene = wall();
+        let x = reach(0.55);
+        let clearance = 0.05;
+        let mut g = [[0.0; JOINTS]; H];
+        let c = trajectory_cost(&scene, &x, clearance, Some(&mut g)).unwrap();
+        assert!(c > 0.0, "the arm comes within the clearance of the wall");
+        assert_eq!(g[0], [0.0; JOINTS]);
+        assert_eq!(g[H - 1], [0.0; JOINTS]);
+        let mut checked = 0;
+        for w in 1..H - 1 {
+            for j in 0..JOINTS {
+                let h = 1e-3;
+                let (mut up, mut down) = (x, x);
+                up[w][j] += h;
+                down[w][j] -= h;
+                let fd = (trajectory_cost(&scene, &up, clearance, None).unwrap()
+                    - trajectory_cost(&scene, &down, clearance, None).unwrap())
+                    / (2.0 * h);
+                let scale = fd.abs().max(g[w][j].abs()).max(1e-3);
+                assert!(
+                    (fd - g[w][j]).abs() <= 0.05 * scale,
+                    "w {w} j {j}: fd {fd} vs {}",
+                    g[w][j]
+                );
+                checked += usize::from(fd.abs() > 1e-3);
+            }
+        }
+        assert!(checked >= 4, "some joints move the arm towards the wall");
+        // A small step down the gradient lowers the cost.
+        let norm = libm::sqrtf(g.iter().flatten().map(|v| v * v).sum::<f32>());
+        let mut next = x;
+        for (q, gq) in next.iter_mut().zip(&g) {
+            for (v, gv) in q.iter_mut().zip(gq) {
+                *v -= 0.01 * gv / norm;
+            }
+        }
+        assert!(trajectory_cost(&scene, &next, clearance, None).unwrap() < c);
+    }
+
+    #[test]
+    fn inside_an_obstacle_the_gap_is_negative_and_points_out() {
+        let b = Primitive::obstacle(&Obstacle::cuboid([0.0; 3], [1.0, 1.0, 0.2], [1.0, 0.0, 0.0, 0.0]).unwrap());
+        let a = Primitive::obstacle(&Obstacle::sphere([0.0, 0.3, 0.05], 0.1).unwrap());
+        let (gap, n) = signed_gap(&a, &b, &Vector3::new(0.0, 0.3, 0.05));
+        assert!((gap - (-0.15)).abs() < 1e-5, "{gap}");
+        assert!((n - Vector3::z()).norm() < 1e-6, "{n}");
+    }
+
+    #[test]
+    fn bad_input_is_a_typed_error() {
+        let mut x = reach(0.5);
+        assert_eq!(trajectory_cost(&wall(), &x, -0.1, None), Err(Error::BadParameter));
+        assert_eq!(trajectory_cost(&wall(), &x, f32::NAN, None), Err(Error::BadParameter));
+        x[2][3] = f32::INFINITY;
+        assert_eq!(
+            trajectory_cost(&wall(), &x, 0.05, None),
+            Err(Error::NonFiniteJoint { joint: 3 })
+        );
+    }
+}
