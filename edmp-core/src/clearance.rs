@@ -5,38 +5,43 @@
 //! The checker judges something else, each moving body's convex hull (and the held object)
 //! against the exact primitives, so a row can be box-free and still touch, or touch in the boxes
 //! where the hulls pass (a 26 cm slot between bars is narrower than a forearm's box, not its
-//! hull). This cost measures what the checker measures: over the interior waypoints, bodies and
-//! obstacles, `Σ max(0, c − gap)²`, where `gap` is the signed separation of the hull and the
-//! obstacle along a direction `n`:
-//! - apart: `n` is the direction GJK finds from the obstacle to the hull, and `gap` the exact
+//! hull). This cost measures what the checker measures: over the segments, bodies and
+//! obstacles, `Σ max(0, c − gap)²`, each body on a segment being the convex hull of its two
+//! placements (as EDMP's swept volume unions a segment's two boxes: a cost on the waypoints
+//! alone let rows slip through thin boards between them, measured), and `gap` the signed
+//! separation of that hull and the obstacle along a direction `n`:
+//! - apart: `n` is the direction GJK finds from the obstacle to the body, and `gap` the exact
 //!   lower bound along it (`gjk::gap_along`), the distance up to f32;
 //! - overlapping (GJK finds the origin inside): `n` is the best of the obstacle's face normals
 //!   (both ways) and the direction between the centres, and `gap < 0` the depth along it (the
 //!   shallowest way out that these directions offer).
 //!
 //! The gradient keeps `n` fixed (at the optimum direction the gap is stationary in it) and moves
-//! the hull's support point in `−n`, a point of its closest feature, rigidly with its frame: a
-//! force `−2 (c − gap) n` there ([`Cotangent::add_point`]), then the FK adjoint. Where a hull's
-//! face is the closest feature the moment is that of one of its vertices, not of the witness
-//! point: the joint gradient is then a descent direction, not the exact derivative.
+//! the support point in `−n`, a point of the closest feature, rigidly with its frame at the
+//! segment end it belongs to: a force `−2 (c − gap) n` there ([`Cotangent::add_point`]), then the
+//! FK adjoint. Where a face is the closest feature the moment is that of one of its vertices, not
+//! of the witness point: the joint gradient is then a descent direction, not the exact derivative.
 //!
-//! Work: one FK per interior waypoint, and one GJK per (body, obstacle) pair whose bounding balls
-//! come within `c`; nothing else. A guide with this cost is data like any other
+//! Work: one FK per waypoint; per (body, segment, obstacle) whose bounding balls come within `c`,
+//! a GJK on the body's two oriented boxes (which hold its hulls), and only where those come within
+//! `c` a GJK on the hulls. A guide with this cost is data like any other
 //! ([`crate::guides::CLEARANCE_GUIDE`]).
 
 use crate::checker::moves;
 use crate::convex::{Convex, Hull, Primitive};
 use crate::error::Error;
 use crate::gjk::{closest, gap_along};
-use crate::kinematics::{Cotangent, Joints, forward_with};
+use crate::kinematics::{Cotangent, Joints, Kinematics, forward_with};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::Scene;
 use nalgebra::Vector3;
 
-/// `Σ max(0, clearance − gap)²` over the interior waypoints of `trajectory`, every moving body's
-/// hull (and the held object) and every obstacle of `scene`; with `gradient`, its gradient with
-/// respect to every waypoint (zero at the ends). Non-finite joints and a negative or non-finite
-/// clearance are typed errors; so is an overflowing result.
+/// `Σ max(0, clearance − gap)²` over the `H − 1` segments of `trajectory`, every moving body
+/// (and the held object) and every obstacle of `scene`, each body on a segment being the convex
+/// hull of its placements at the two ends (the swept volume's analogue: a path cannot slip
+/// through a thin board between waypoints); with `gradient`, its gradient with respect to every
+/// waypoint (zero at the ends). Non-finite joints and a negative or non-finite clearance are
+/// typed errors; so is an overflowing result.
 pub fn trajectory_cost<const H: usize, const N: usize>(
     scene: &Scene<N>,
     trajectory: &[Joints<f32>; H],
@@ -72,46 +77,95 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
         g.fill([0.0; JOINTS]);
     }
     let mut total = 0.0f32;
-    for (w, q) in trajectory.iter().enumerate().take(H.saturating_sub(1)).skip(1) {
+    // Waypoint w − 1 and w in flight, each with the cotangent its segments gather.
+    let mut before: Option<(Kinematics<f32>, Cotangent<f32>, bool)> = None;
+    for (w, q) in trajectory.iter().enumerate() {
         let k = forward_with(q, scene.gripper())?;
-        let mut cot = Cotangent::new();
-        let mut touched = false;
-        let mut pair = |shape: &dyn Convex, frame: usize, center: &Vector3<f32>, radius: f32| {
-            for (o, &reach) in obstacles.iter().zip(&reach) {
-                let limit = radius + reach;
-                if (center - o.center).norm_squared() > limit * limit {
-                    continue;
+        let mut current = (k, Cotangent::new(), false);
+        if let Some((kb, cot_b, touched_b)) = before.as_mut() {
+            let (kc, cot_c, touched_c) = (&current.0, &mut current.1, &mut current.2);
+            let mut segment = |ends: [&dyn Convex; 2],
+                               boxes: Option<[&dyn Convex; 2]>,
+                               frame: usize,
+                               centers: [&Vector3<f32>; 2],
+                               radius: f32| {
+                let mid = (centers[0] + centers[1]) * 0.5;
+                let radius = radius + 0.5 * libm::sqrtf((centers[1] - centers[0]).norm_squared());
+                let swept = Union(ends);
+                for (o, &reach) in obstacles.iter().zip(&reach) {
+                    let limit = radius + reach;
+                    if (mid - o.center).norm_squared() > limit * limit {
+                        continue;
+                    }
+                    // The bodies' boxes hold their hulls: boxes proven `clearance` apart are
+                    // enough, and a box's support is three signs, not a scan of the hull.
+                    let mut towards = mid - o.center;
+                    if let Some(boxes) = boxes {
+                        match closest(&Union(boxes), o, &towards) {
+                            Some(v) if apart_by(&Union(boxes), o, &v, clearance) => continue,
+                            Some(v) => towards = v,
+                            None => {}
+                        }
+                    }
+                    let (gap, n) = signed_gap(&swept, o, &towards);
+                    if gap >= clearance {
+                        continue;
+                    }
+                    let depth = clearance - gap;
+                    total += depth * depth;
+                    let (side, point) = swept.support_side(&-n);
+                    let pull = n * (-2.0 * depth);
+                    if side == 0 {
+                        cot_b.add_point(frame, &point, &pull);
+                        *touched_b = true;
+                    } else {
+                        cot_c.add_point(frame, &point, &pull);
+                        *touched_c = true;
+                    }
                 }
-                let (gap, n) = signed_gap(shape, o, &(center - o.center));
-                if gap >= clearance {
-                    continue;
-                }
-                let depth = clearance - gap;
-                total += depth * depth;
-                cot.add_point(frame, &shape.support(&-n), &(n * (-2.0 * depth)));
-                touched = true;
-            }
-        };
-        for b in (0..BODIES).filter(|&b| moves(b)) {
-            let frame = PANDA.bodies[b].frame.min(FRAMES - 1);
-            let hull = Hull {
-                pose: &k.frames[frame],
-                points: PANDA.hull(b),
             };
-            pair(&hull, frame, &k.boxes[b].translation, radius[b]);
+            for b in (0..BODIES).filter(|&b| moves(b)) {
+                let frame = PANDA.bodies[b].frame.min(FRAMES - 1);
+                let points = PANDA.hull(b);
+                let (hb, hc) = (
+                    Hull {
+                        pose: &kb.frames[frame],
+                        points,
+                    },
+                    Hull {
+                        pose: &kc.frames[frame],
+                        points,
+                    },
+                );
+                let half = &PANDA.bodies[b].half_extents;
+                let (bb, bc) = (
+                    Primitive::cuboid(&kb.boxes[b], half),
+                    Primitive::cuboid(&kc.boxes[b], half),
+                );
+                let centers = [&kb.boxes[b].translation, &kc.boxes[b].translation];
+                segment([&hb, &hc], Some([&bb, &bc]), frame, centers, radius[b]);
+            }
+            if let Some(h) = scene.held() {
+                let (pb, pc) = (
+                    Primitive::attached(h, &kb.frames[HAND_FRAME]),
+                    Primitive::attached(h, &kc.frames[HAND_FRAME]),
+                );
+                segment(
+                    [&pb, &pc],
+                    None,
+                    HAND_FRAME,
+                    [&pb.center, &pc.center],
+                    pb.bounding_radius(),
+                );
+            }
         }
-        if let Some(h) = scene.held() {
-            let held = Primitive::attached(h, &k.frames[HAND_FRAME]);
-            pair(&held, HAND_FRAME, &held.center, held.bounding_radius());
+        if let Some((kb, cot_b, touched_b)) = before.take() {
+            write_gradient(gradient.as_deref_mut(), w - 1, &kb, &cot_b, touched_b)?;
         }
-        if let Some(slot) = gradient.as_deref_mut().and_then(|g| g.get_mut(w))
-            && touched
-        {
-            *slot = k.joint_gradient(&cot).map_err(|e| match e {
-                Error::NonFiniteGradient => Error::Overflow,
-                other => other,
-            })?;
-        }
+        before = Some(current);
+    }
+    if let Some((kb, cot_b, touched_b)) = before {
+        write_gradient(gradient.as_deref_mut(), H - 1, &kb, &cot_b, touched_b)?;
     }
     if total.is_finite() {
         Ok(total)
@@ -120,11 +174,54 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     }
 }
 
+/// Waypoint `w`'s joint gradient from its cotangent, zero at the ends and where nothing pulled.
+fn write_gradient<const H: usize>(
+    gradient: Option<&mut [Joints<f32>; H]>,
+    w: usize,
+    k: &Kinematics<f32>,
+    cot: &Cotangent<f32>,
+    touched: bool,
+) -> Result<(), Error> {
+    if w == 0 || w + 1 >= H || !touched {
+        return Ok(());
+    }
+    if let Some(slot) = gradient.and_then(|g| g.get_mut(w)) {
+        *slot = k.joint_gradient(cot).map_err(|e| match e {
+            Error::NonFiniteGradient => Error::Overflow,
+            other => other,
+        })?;
+    }
+    Ok(())
+}
+
+/// Whether `a` is proven more than `clearance` from `b` along GJK's vector `v` (from `b` to `a`).
+fn apart_by<A: Convex>(a: &A, b: &Primitive, v: &Vector3<f32>, clearance: f32) -> bool {
+    let len = libm::sqrtf(v.norm_squared());
+    len > 0.0 && len.is_finite() && gap_along(a, b, &(v / len)) >= clearance
+}
+
+/// The convex hull of two placements of a body (a segment's ends).
+struct Union<'a>([&'a dyn Convex; 2]);
+
+impl Union<'_> {
+    /// Which placement (0 or 1) holds the support point along `d`, and the point.
+    fn support_side(&self, d: &Vector3<f32>) -> (usize, Vector3<f32>) {
+        let [a, b] = self.0;
+        let (pa, pb) = (a.support(d), b.support(d));
+        if pb.dot(d) > pa.dot(d) { (1, pb) } else { (0, pa) }
+    }
+}
+
+impl Convex for Union<'_> {
+    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
+        self.support_side(d).1
+    }
+}
+
 /// The signed separation of `a` from `b` along a direction `n` (unit, from `b` towards `a`) and
 /// that direction: GJK's when they are apart, else the best of `b`'s face normals and the
 /// centres' direction `towards` (see the module docs).
-fn signed_gap(a: &dyn Convex, b: &Primitive, towards: &Vector3<f32>) -> (f32, Vector3<f32>) {
-    let a = &Dyn(a);
+fn signed_gap<A: Convex>(a: &A, b: &Primitive, towards: &Vector3<f32>) -> (f32, Vector3<f32>) {
     if let Some(v) = closest(a, b, towards) {
         let len = libm::sqrtf(v.norm_squared());
         if len > 0.0 && len.is_finite() {
@@ -150,19 +247,6 @@ fn signed_gap(a: &dyn Convex, b: &Primitive, towards: &Vector3<f32>) -> (f32, Ve
         }
     }
     best
-}
-
-/// A `dyn Convex` as a sized one, for GJK's generic functions.
-struct Dyn<'a>(&'a dyn Convex);
-
-impl Convex for Dyn<'_> {
-    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
-        self.0.support(d)
-    }
-
-    fn face_normals(&self) -> Option<nalgebra::Matrix3<f32>> {
-        self.0.face_normals()
-    }
 }
 
 #[cfg(test)]
@@ -234,6 +318,26 @@ mod tests {
             }
         }
         assert!(trajectory_cost(&scene, &next, clearance, None).unwrap() < c);
+    }
+
+    #[test]
+    fn a_segment_through_a_thin_board_costs_though_both_its_ends_are_clear() {
+        let mut scene = Scene::<4>::new();
+        let board = Obstacle::cuboid([0.55, 0.0, 0.4], [0.3, 0.01, 0.8], [1.0, 0.0, 0.0, 0.0]);
+        scene.push(board.unwrap()).unwrap();
+        let (a, b) = (
+            [-0.7, 0.3, 0.0, -2.0, 0.0, 2.2, 0.7],
+            [0.7, 0.3, 0.0, -2.0, 0.0, 2.2, 0.7],
+        );
+        let cost = |x: &[Joints<f32>; 3]| trajectory_cost(&scene, x, 0.01, None).unwrap();
+        assert_eq!(cost(&[a; 3]), 0.0);
+        assert_eq!(cost(&[b; 3]), 0.0);
+        let mut g = [[0.0; JOINTS]; 3];
+        assert!(trajectory_cost(&scene, &[a, a, b], 0.01, Some(&mut g)).unwrap() > 0.0);
+        assert!(
+            g[1].iter().any(|&v| v != 0.0),
+            "the interior waypoint is pulled back from the board"
+        );
     }
 
     #[test]

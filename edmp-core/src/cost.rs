@@ -31,8 +31,8 @@ pub enum CostKind {
     Intersection,
     /// Swept volume over segments ("sv").
     Swept,
-    /// The exact clearance of the checker's hulls from the true obstacles over the interior
-    /// waypoints, within the inflation's clearance ([`crate::clearance`]; not EDMP's: an
+    /// The exact clearance of the checker's hulls from the true obstacles over the segments,
+    /// within the inflation's clearance ([`crate::clearance`]; not EDMP's: an
     /// ablation of the stronger local optimizer). Expansion, cylinder boxes and frame do not
     /// apply.
     Clearance,
