@@ -66,7 +66,11 @@ fuzz_target!(|data: &[u8]| {
     }
     let inflation = Inflation { clearance: r.f32(), expansion: r.f32() };
     let trajectory: [[f32; 7]; H] = core::array::from_fn(|_| r.array::<7>());
-    let kind = if flags & 1 == 0 { CostKind::Intersection } else { CostKind::Swept };
+    let kind = match (flags & 32 != 0, flags & 1 == 0) {
+        (true, _) => CostKind::Clearance,
+        (false, true) => CostKind::Intersection,
+        (false, false) => CostKind::Swept,
+    };
     let cylinder = if flags & 2 == 0 { CylinderBox::Enclosing } else { CylinderBox::OriginalEdmp };
     let frame = if flags & 16 == 0 { BoxFrame::Obstacle } else { BoxFrame::World };
     let config = CostConfig { kind, inflation, cylinder, frame };
