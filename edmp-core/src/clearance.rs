@@ -165,7 +165,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
         before = Some(current);
     }
     if let Some((kb, cot_b, touched_b)) = before {
-        write_gradient(gradient.as_deref_mut(), H - 1, &kb, &cot_b, touched_b)?;
+        write_gradient(gradient, H - 1, &kb, &cot_b, touched_b)?;
     }
     if total.is_finite() {
         Ok(total)
