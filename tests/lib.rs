@@ -298,6 +298,9 @@ pub mod reference {
                     }
                 }
             }
+            // Not one of EDMP's box costs: its GJK gaps have no f64 twin here; the core's own
+            // tests check it (finite differences, descent, segments through thin boards).
+            CostKind::Clearance => panic!("reference::cost models EDMP's box costs, not CostKind::Clearance"),
         }
         Evaluation {
             value: total,

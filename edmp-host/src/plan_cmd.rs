@@ -9,7 +9,7 @@ use crate::timed::{TimedArgs, TimedRequest, trajectory_document};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::geometry::{BoxFrame, Inflation};
 use edmp_core::global::GlobalConfig;
-use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide};
+use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide, Schedule};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
     PlanConfig, RefineStop, Workspace, denoise, finish, polish, select,
@@ -110,9 +110,10 @@ pub struct Tuning {
     #[arg(long)]
     step_control: bool,
     /// Refine every row with the exact-clearance guide (the checker's hulls against the true
-    /// obstacles, 3 cm) instead of its own guide. An ablation.
-    #[arg(long)]
-    refine_clearance: bool,
+    /// obstacles, within this clearance in metres; 0.03 when given without a value) instead of
+    /// its own guide. An ablation.
+    #[arg(long, num_args = 0..=1, default_missing_value = "0.03", value_name = "METRES")]
+    refine_clearance: Option<f32>,
 }
 
 impl Tuning {
@@ -175,7 +176,10 @@ impl Tuning {
                 every: self.refine_check_every,
                 free: self.refine_stop_free,
             }),
-            refine_guide: self.refine_clearance.then_some(CLEARANCE_GUIDE),
+            refine_guide: self.refine_clearance.map(|c| Guide {
+                clearance: Schedule::Constant(c),
+                ..CLEARANCE_GUIDE
+            }),
             step_control: self.step_control,
             ..PlanConfig::DEFAULT
         };
@@ -183,6 +187,13 @@ impl Tuning {
             return Err(Failure::Input(format!(
                 "--step-limit: {} is not a positive number of radians",
                 self.step_limit
+            )));
+        }
+        if let Some(c) = self.refine_clearance
+            && !(c.is_finite() && c >= 0.0)
+        {
+            return Err(Failure::Input(format!(
+                "--refine-clearance: {c} is not a clearance in metres (finite, at least 0)"
             )));
         }
         if self.refine_check_every > 0 && self.refine_stop_free == 0 {
@@ -250,8 +261,8 @@ impl Tuning {
         if self.step_control {
             boxes = format!("{boxes}, step control");
         }
-        if self.refine_clearance {
-            boxes = format!("{boxes}, clearance refinement");
+        if let Some(c) = self.refine_clearance {
+            boxes = format!("{boxes}, clearance refinement ({c} m)");
         }
         if self.ancestral {
             format!(
