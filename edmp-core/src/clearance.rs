@@ -320,6 +320,53 @@ mod tests {
         assert!(trajectory_cost(&scene, &next, clearance, None).unwrap() < c);
     }
 
+    /// Many arms near many obstacles (a fixed stream of random cases): wherever the cost pulls,
+    /// a small step down its gradient lowers it. Where the closest features are faces the
+    /// moment is a vertex's, so this is the property the refinement relies on, not equality
+    /// with finite differences; a handful of cases at support switches may not descend.
+    #[test]
+    fn the_gradient_descends_on_random_cases() {
+        let mut rng = crate::rng::Rng::new(7);
+        let mut u = |lo: f32, hi: f32| rng.uniform_f32(lo, hi);
+        let (mut pulled, mut descended) = (0, 0);
+        for _ in 0..200 {
+            let a: Joints<f32> = core::array::from_fn(|j| u(PANDA.soft_lower[j], PANDA.soft_upper[j]));
+            let b: Joints<f32> =
+                core::array::from_fn(|j| (a[j] + u(-0.4, 0.4)).clamp(PANDA.soft_lower[j], PANDA.soft_upper[j]));
+            let x: [Joints<f32>; H] = core::array::from_fn(|w| {
+                let t = w as f32 / (H - 1) as f32;
+                core::array::from_fn(|j| a[j] + t * (b[j] - a[j]))
+            });
+            let k = forward_with(&x[H / 2], 0.025).unwrap();
+            let near = k.boxes[(u(1.0, BODIES as f32) as usize).min(BODIES - 1)].translation;
+            let mut scene = Scene::<4>::new();
+            let center = [near.x + u(-0.1, 0.1), near.y + u(-0.1, 0.1), near.z + u(-0.1, 0.1)];
+            let o = match u(0.0, 3.0) as u32 {
+                0 => Obstacle::cuboid(center, [u(0.02, 0.3), u(0.02, 0.3), u(0.02, 0.3)], [1.0, 0.0, 0.0, 0.0]),
+                1 => Obstacle::cylinder(center, u(0.02, 0.1), u(0.05, 0.4), [0.9, 0.1, 0.3, 0.3]),
+                _ => Obstacle::sphere(center, u(0.02, 0.12)),
+            };
+            scene.push(o.unwrap()).unwrap();
+            let mut g = [[0.0; JOINTS]; H];
+            let c = trajectory_cost(&scene, &x, 0.03, Some(&mut g)).unwrap();
+            assert!(c.is_finite() && c >= 0.0);
+            let norm = libm::sqrtf(g.iter().flatten().map(|v| v * v).sum::<f32>());
+            if norm == 0.0 {
+                continue;
+            }
+            pulled += 1;
+            let mut next = x;
+            for (q, gq) in next.iter_mut().zip(&g) {
+                for (v, gv) in q.iter_mut().zip(gq) {
+                    *v -= 1e-3 * gv / norm;
+                }
+            }
+            descended += usize::from(trajectory_cost(&scene, &next, 0.03, None).unwrap() < c);
+        }
+        assert!(pulled >= 50, "{pulled} cases pull");
+        assert!(descended * 100 >= pulled * 95, "{descended} of {pulled} descend");
+    }
+
     #[test]
     fn a_segment_through_a_thin_board_costs_though_both_its_ends_are_clear() {
         let mut scene = Scene::<4>::new();
