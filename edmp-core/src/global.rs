@@ -16,10 +16,11 @@
 
 use crate::checker::check_segment;
 use crate::error::Error;
+use crate::executor::Executor;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
 use crate::planner::{Plan, PlanConfig, RowChecks, Workspace, guide_steps, judge, rank_in_full, refine, select};
-use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise};
+use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise_on};
 use crate::rng::Rng;
 use crate::scene::Scene;
 use crate::search::{SearchConfig, search};
@@ -103,7 +104,8 @@ pub struct SearchReport {
 /// place): when the search finds nothing, `plan` keeps the first stage's candidates (ranked
 /// in full) and the search's report.
 #[allow(clippy::too_many_arguments)]
-pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
+pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+    exec: &E,
     scene: &Scene<N>,
     start: &Joints<f32>,
     goal: &Joints<f32>,
@@ -111,7 +113,7 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     config: &PlanConfig,
     global: &GlobalConfig,
     rng: &mut Rng,
-    scratch: &mut Scratch<C>,
+    scratches: &mut [Scratch<C>],
     work: &mut Workspace<B, CAP>,
     plan: &mut Plan<B>,
 ) -> Result<(), Error> {
@@ -141,11 +143,17 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     }
     let strided = Sampler::Strided { steps: global.steps };
     let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16, steps: u8| {
-        guide_steps(scene, paths, grads, guides, t, steps, config)
+        guide_steps(exec, scene, paths, grads, guides, t, steps, config)
     };
     for j in 0..usize::from(global.steps) {
         let step = Step::partial(global.noise_step, global.steps, j);
-        predict_noise(&plan.paths, &TimeEmbedding::new(step.t)?, scratch, &mut work.eps)?;
+        predict_noise_on(
+            exec,
+            &plan.paths[..],
+            &TimeEmbedding::new(step.t)?,
+            scratches,
+            &mut work.eps,
+        )?;
         for (x, e) in plan.paths.iter_mut().zip(&work.eps) {
             strided.update(step, x, e, rng, start, goal);
         }
@@ -154,6 +162,7 @@ pub fn rescue<const B: usize, const N: usize, const C: usize, const CAP: usize>(
         }
     }
     refine(
+        exec,
         scene,
         start,
         goal,

@@ -10,6 +10,7 @@
 
 use crate::cost::{CostConfig, trajectory_cost};
 use crate::error::Error;
+use crate::executor::{Executor, MAX_PARTS, split};
 use crate::geometry::{BoxFrame, CylinderBox};
 use crate::guides::Guide;
 use crate::kinematics::Joints;
@@ -46,6 +47,63 @@ pub fn guide_step<const H: usize, const N: usize>(
         frame,
     };
     step_rows(scene, rows, grads, guides, t, &rule, settled, None)
+}
+
+/// [`guide_step`] with the guides cut into groups run by `exec` (each group steps its own
+/// rows: the same bits as one call).
+#[allow(clippy::too_many_arguments)]
+pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
+    exec: &E,
+    scene: &Scene<N>,
+    rows: &mut [[Joints<f32>; H]],
+    grads: &mut [[Joints<f32>; H]],
+    guides: &[Guide],
+    t: u16,
+    rule: &StepRule,
+    settled: &mut [bool],
+) -> Result<(), Error> {
+    if exec.parts() <= 1 {
+        return step_rows(scene, rows, grads, guides, t, rule, settled, None);
+    }
+    if guides.is_empty() || !rows.len().is_multiple_of(guides.len()) || grads.len() != rows.len() {
+        return Err(Error::BadParameter);
+    }
+    if !settled.is_empty() && settled.len() != guides.len() {
+        return Err(Error::BadParameter);
+    }
+    struct Part<'a, const H: usize> {
+        guides: &'a [Guide],
+        rows: &'a mut [[Joints<f32>; H]],
+        grads: &'a mut [[Joints<f32>; H]],
+        settled: &'a mut [bool],
+    }
+    let per_guide = rows.len() / guides.len();
+    let mut parts: heapless::Vec<Part<'_, H>, MAX_PARTS> = heapless::Vec::new();
+    let (mut g_rest, mut r_rest, mut d_rest, mut s_rest) = (guides, rows, grads, settled);
+    for &len in split(guides.len(), 1, exec.parts()).iter().filter(|&&l| l > 0) {
+        let (rows_len, settled_len) = ((len * per_guide).min(r_rest.len()), len.min(s_rest.len()));
+        let (Some((g, gr)), Some((r, rr)), Some((d, dr)), Some((s, sr))) = (
+            g_rest.split_at_checked(len),
+            core::mem::take(&mut r_rest).split_at_mut_checked(rows_len),
+            core::mem::take(&mut d_rest).split_at_mut_checked(rows_len),
+            core::mem::take(&mut s_rest).split_at_mut_checked(settled_len),
+        ) else {
+            return Err(Error::BadParameter);
+        };
+        (g_rest, r_rest, d_rest, s_rest) = (gr, rr, dr, sr);
+        let part = Part {
+            guides: g,
+            rows: r,
+            grads: d,
+            settled: s,
+        };
+        if parts.push(part).is_err() {
+            return Err(Error::BadParameter);
+        }
+    }
+    exec.each(&mut parts, |p| {
+        step_rows(scene, p.rows, p.grads, p.guides, t, rule, p.settled, None)
+    })
 }
 
 /// How [`guide_step`] moves rows: the per-joint step limit and how the costs box things.
@@ -299,6 +357,70 @@ mod tests {
             assert!(after < before, "guide {}: {before} → {after}", guide.id);
             assert_eq!(rows[0][0], a);
             assert_eq!(rows[0][H - 1], b);
+        }
+    }
+
+    /// Runs items in reverse order, cut into `self.0` parts.
+    struct Reversed(usize);
+
+    impl Executor for Reversed {
+        fn parts(&self) -> usize {
+            self.0
+        }
+        fn each<T: Send, F: Fn(&mut T) -> Result<(), Error> + Sync>(
+            &self,
+            items: &mut [T],
+            task: F,
+        ) -> Result<(), Error> {
+            items.iter_mut().rev().try_for_each(task)
+        }
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "guidance steps over a batch: too slow under Miri")]
+    fn guides_in_parts_step_the_same_bits() {
+        let scene = scene();
+        let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let b = [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
+        let rule = StepRule {
+            step_limit: 0.1,
+            cylinder: CylinderBox::Enclosing,
+            frame: BoxFrame::Obstacle,
+        };
+        let mut whole = [line(a, b); 24];
+        let mut grads = [[[0.0; 7]; H]; 24];
+        let mut settled = [false; 12];
+        for _ in 0..3 {
+            step_rows(
+                &scene,
+                &mut whole,
+                &mut grads,
+                &EDMP_GUIDES,
+                30,
+                &rule,
+                &mut settled,
+                None,
+            )
+            .unwrap();
+        }
+        assert!(whole != [line(a, b); 24], "the guides moved the rows");
+        for parts in [2, 3, 5, 8] {
+            let mut rows = [line(a, b); 24];
+            let mut flags = [false; 12];
+            for _ in 0..3 {
+                guide_step_on(
+                    &Reversed(parts),
+                    &scene,
+                    &mut rows,
+                    &mut grads,
+                    &EDMP_GUIDES,
+                    30,
+                    &rule,
+                    &mut flags,
+                )
+                .unwrap();
+            }
+            assert!(rows == whole && flags == settled, "{parts} parts");
         }
     }
 

@@ -23,6 +23,7 @@ pub mod clearance;
 pub mod convex;
 pub mod cost;
 pub mod error;
+pub mod executor;
 pub mod geometry;
 pub mod gjk;
 pub mod global;

@@ -14,13 +14,14 @@
 use crate::checker::{CheckConfig, check_trajectory, check_trajectory_from};
 use crate::cost::{CostConfig, CostKind, trajectory_cost};
 use crate::error::Error;
+use crate::executor::{Executor, Serial};
 use crate::geometry::{BoxFrame, CylinderBox, Inflation};
 use crate::global::{GlobalConfig, SearchReport, Stage, rescue};
-use crate::guidance::{StepControl, StepRule, guide_step, guide_step_controlled};
+use crate::guidance::{StepControl, StepRule, guide_step_controlled, guide_step_on};
 use crate::guides::Guide;
 use crate::kinematics::Joints;
 use crate::prior::{
-    HORIZON, Path, Sampler, Scratch, TimeEmbedding, check_joints, free_ends, initial_noise, inpaint, predict_noise,
+    HORIZON, Path, Sampler, Scratch, TimeEmbedding, check_joints, free_ends, initial_noise, inpaint, predict_noise_on,
 };
 use crate::rng::Rng;
 use crate::robot::{JOINTS, PANDA};
@@ -311,11 +312,43 @@ pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     scratch: &mut Scratch<C>,
     work: &mut Workspace<B, CAP>,
 ) -> Result<Plan<B>, Error> {
+    let scratches = core::slice::from_mut(scratch);
+    plan_on(&Serial, scene, start, goal, guides, config, rng, scratches, work)
+}
+
+/// [`plan`] with the network's batch, the guides and the refinement's checks cut into parts
+/// that `exec` runs (one part per scratch at most): the same bits as [`plan`] whatever the
+/// executor ([`crate::executor`]).
+#[allow(clippy::too_many_arguments)]
+pub fn plan_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+    exec: &E,
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    rng: &mut Rng,
+    scratches: &mut [Scratch<C>],
+    work: &mut Workspace<B, CAP>,
+) -> Result<Plan<B>, Error> {
     // One plan's memory throughout: denoised into, judged in place, reseeded in place.
     let mut plan = Plan::empty();
-    denoise(scene, start, goal, guides, config, rng, scratch, work, &mut plan.paths)?;
+    denoise_on(
+        exec,
+        scene,
+        start,
+        goal,
+        guides,
+        config,
+        rng,
+        scratches,
+        work,
+        &mut plan.paths,
+    )?;
     judge(scene, start, goal, config, &mut plan, &work.checks)?;
-    finish(scene, start, goal, guides, config, rng, scratch, work, &mut plan)?;
+    finish_on(
+        exec, scene, start, goal, guides, config, rng, scratches, work, &mut plan,
+    )?;
     polish(scene, start, goal, config, rng, &mut plan)?;
     Ok(plan)
 }
@@ -334,10 +367,30 @@ pub fn finish<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     work: &mut Workspace<B, CAP>,
     plan: &mut Plan<B>,
 ) -> Result<(), Error> {
+    let scratches = core::slice::from_mut(scratch);
+    finish_on(&Serial, scene, start, goal, guides, config, rng, scratches, work, plan)
+}
+
+/// [`finish`] with its work run by `exec` ([`plan_on`]).
+#[allow(clippy::too_many_arguments)]
+pub fn finish_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+    exec: &E,
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    rng: &mut Rng,
+    scratches: &mut [Scratch<C>],
+    work: &mut Workspace<B, CAP>,
+    plan: &mut Plan<B>,
+) -> Result<(), Error> {
     if let Some(global) = &config.global
         && !plan.is_free()
     {
-        rescue(scene, start, goal, guides, config, global, rng, scratch, work, plan)?;
+        rescue(
+            exec, scene, start, goal, guides, config, global, rng, scratches, work, plan,
+        )?;
     }
     Ok(())
 }
@@ -374,7 +427,8 @@ pub fn polish<const B: usize, const N: usize>(
 /// and boxes (the first stage's and the global stage's guidance alike). A guide whose rows stop
 /// moving is settled and skipped for the rest of the steps: at a fixed `t` its next step would
 /// be the same no-op, so this saves work and changes no bit ([`guide_step`]).
-pub(crate) fn guide_steps<const B: usize, const N: usize>(
+pub(crate) fn guide_steps<E: Executor, const B: usize, const N: usize>(
+    exec: &E,
     scene: &Scene<N>,
     paths: &mut [Path; B],
     grads: &mut [Path; B],
@@ -386,7 +440,7 @@ pub(crate) fn guide_steps<const B: usize, const N: usize>(
     let mut settled = [false; B];
     let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
     for _ in 0..steps {
-        guide_once(scene, paths, grads, guides, t, config, settled)?;
+        guide_once(exec, scene, paths, grads, guides, t, config, settled)?;
         if settled.iter().all(|&s| s) {
             break;
         }
@@ -394,8 +448,10 @@ pub(crate) fn guide_steps<const B: usize, const N: usize>(
     Ok(())
 }
 
-/// One [`guide_step`] with the plan's step limit and boxes.
-fn guide_once<const B: usize, const N: usize>(
+/// One [`guide_step`] with the plan's step limit and boxes, its guides run by `exec`.
+#[allow(clippy::too_many_arguments)]
+fn guide_once<E: Executor, const B: usize, const N: usize>(
+    exec: &E,
     scene: &Scene<N>,
     paths: &mut [Path; B],
     grads: &mut [Path; B],
@@ -404,17 +460,12 @@ fn guide_once<const B: usize, const N: usize>(
     config: &PlanConfig,
     settled: &mut [bool],
 ) -> Result<(), Error> {
-    guide_step(
-        scene,
-        paths,
-        grads,
-        guides,
-        t,
-        config.step_limit,
-        config.cylinder,
-        config.frame,
-        settled,
-    )
+    let rule = StepRule {
+        step_limit: config.step_limit,
+        cylinder: config.cylinder,
+        frame: config.frame,
+    };
+    guide_step_on(exec, scene, paths, grads, guides, t, &rule, settled)
 }
 
 /// The refinement: `steps` gradient steps of every row's guide at t = 1 (or of
@@ -422,7 +473,8 @@ fn guide_once<const B: usize, const N: usize>(
 /// `config.refine_stop` ([`RefineStop`]); shared by the first stage and the global stage.
 /// `saved` is working memory for the step-size control.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn refine<const B: usize, const N: usize>(
+pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
+    exec: &E,
     scene: &Scene<N>,
     start: &Joints<f32>,
     goal: &Joints<f32>,
@@ -468,15 +520,23 @@ pub(crate) fn refine<const B: usize, const N: usize>(
         if let Some(stop) = config.refine_stop
             && s % stop.every == 0
         {
-            let rows = paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut());
-            for ((x, done), touched) in rows.filter(|((_, done), _)| !**done) {
-                let mut judged = *x;
+            // Each row's check is its own: `exec` may run them at once.
+            let mut rows: heapless::Vec<(&Path, &mut bool, &mut Option<u16>), B> = heapless::Vec::new();
+            for ((x, done), touched) in paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut()) {
+                if !*done && rows.push((x, done, touched)).is_err() {
+                    return Err(Error::BadParameter);
+                }
+            }
+            exec.each(&mut rows, |(x, done, touched)| {
+                let mut judged = **x;
                 clamp_for_judging(&mut judged, start, goal);
                 let from = touched.map_or(0, usize::from);
                 let report = check_trajectory_from(scene, &judged, &config.check, from)?;
-                *done = report.is_free();
-                *touched = report.first_contact.map(|c| c.segment);
-            }
+                **done = report.is_free();
+                **touched = report.first_contact.map(|c| c.segment);
+                Ok(())
+            })?;
+            drop(rows);
             if certified.iter().filter(|&&c| c).count() >= usize::from(stop.free) {
                 return Ok(());
             }
@@ -497,7 +557,7 @@ pub(crate) fn refine<const B: usize, const N: usize>(
             };
             guide_step_controlled(scene, paths, grads, guides, 1, &rule, settled, &mut control)?;
         } else {
-            guide_once(scene, paths, grads, guides, 1, config, settled)?;
+            guide_once(exec, scene, paths, grads, guides, 1, config, settled)?;
         }
         if settled.iter().all(|&s| s) {
             break;
@@ -530,6 +590,24 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
     work: &mut Workspace<B, CAP>,
     paths: &mut [Path; B],
 ) -> Result<(), Error> {
+    let scratches = core::slice::from_mut(scratch);
+    denoise_on(&Serial, scene, start, goal, guides, config, rng, scratches, work, paths)
+}
+
+/// [`denoise`] with its work run by `exec` ([`plan_on`]).
+#[allow(clippy::too_many_arguments)]
+pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+    exec: &E,
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    rng: &mut Rng,
+    scratches: &mut [Scratch<C>],
+    work: &mut Workspace<B, CAP>,
+    paths: &mut [Path; B],
+) -> Result<(), Error> {
     config.sampler.validate()?;
     check_joints(start)?;
     check_joints(goal)?;
@@ -543,12 +621,12 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
         }
     }
     let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16, steps: u8| {
-        guide_steps(scene, paths, grads, guides, t, steps, config)
+        guide_steps(exec, scene, paths, grads, guides, t, steps, config)
     };
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
-        predict_noise(paths, &time, scratch, &mut work.eps)?;
+        predict_noise_on(exec, &paths[..], &time, scratches, &mut work.eps)?;
         for (x, e) in paths.iter_mut().zip(&work.eps) {
             if config.condition {
                 config.sampler.update(step, x, e, rng, start, goal);
@@ -564,6 +642,7 @@ pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>
         }
     }
     refine(
+        exec,
         scene,
         start,
         goal,
@@ -929,6 +1008,7 @@ mod tests {
                 touched: [Some(3); 12],
             };
             refine(
+                &Serial,
                 &scene,
                 &START,
                 &GOAL,

@@ -9,7 +9,7 @@
 use crate::Failure;
 use crate::json::{Goal, parse_problem};
 use crate::metrics::{Roughness, acsm, path_length, roughness};
-use crate::plan_cmd::{Tuning, chosen_guides, plan_problem};
+use crate::plan_cmd::{Tuning, chosen_guides, plan_problem_on};
 use crate::plots;
 use core::time::Duration;
 use edmp_core::checker::{CheckConfig, check_trajectory};
@@ -153,7 +153,7 @@ fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
     let parsed = parse_problem(text).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
     let guides = args.tuning.guides(&args.guides)?;
     let config = args.tuning.config()?;
-    let planned = plan_problem(&parsed, &guides, &config, args.seed)?;
+    let planned = plan_problem_on(&parsed, &guides, &config, args.seed, args.tuning.threads()?)?;
     let plan = &planned.plan;
     let per_guide = plan.paths.len() / guides.len();
     let best = &plan.paths[plan.best];

@@ -20,6 +20,7 @@ pub mod rrt_cmd;
 pub mod sample;
 mod scenes;
 pub mod suite;
+pub mod threads;
 pub mod timed;
 
 /// What went wrong, and the exit status it maps to (`spec/formats.md`).

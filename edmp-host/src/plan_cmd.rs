@@ -5,14 +5,16 @@
 
 use crate::Failure;
 use crate::json::{Problem, joint_goal, parse_problem};
+use crate::threads::Threads;
 use crate::timed::{TimedArgs, TimedRequest, trajectory_document};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
+use edmp_core::executor::{Executor, Serial};
 use edmp_core::geometry::{BoxFrame, Inflation};
 use edmp_core::global::GlobalConfig;
 use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide, Schedule};
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
-    PlanConfig, RefineStop, Workspace, denoise, finish, polish, select,
+    PlanConfig, RefineStop, Workspace, denoise_on, finish_on, polish, select,
 };
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
@@ -114,9 +116,23 @@ pub struct Tuning {
     /// its own guide. An ablation.
     #[arg(long, num_args = 0..=1, default_missing_value = "0.03", value_name = "METRES")]
     refine_clearance: Option<f32>,
+    /// Plan on this many threads (the network's batch, the guides and the refinement's checks
+    /// split among them): the same plan, bit for bit, as on one.
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
 }
 
 impl Tuning {
+    /// Threads per plan (`--threads`, at least 1).
+    pub fn threads(&self) -> Result<usize, Failure> {
+        match self.threads {
+            0 => Err(Failure::Input(
+                "--threads: 0 threads cannot plan (at least 1)".to_owned(),
+            )),
+            n => Ok(n),
+        }
+    }
+
     /// The guides named by `ids` ([`chosen_guides`]) with this tuning's smoothness weight.
     pub fn guides(&self, ids: &[u8]) -> Result<Vec<Guide>, Failure> {
         if !(self.smooth.is_finite() && (0.0..0.125).contains(&self.smooth)) {
@@ -264,6 +280,9 @@ impl Tuning {
         if let Some(c) = self.refine_clearance {
             boxes = format!("{boxes}, clearance refinement ({c} m)");
         }
+        if self.threads > 1 {
+            boxes = format!("{boxes}, {} threads", self.threads);
+        }
         if self.ancestral {
             format!(
                 "ancestral K = 255, guidance on even t, {} refinement steps, {limit}{boxes}",
@@ -304,22 +323,52 @@ impl Planned {
 
 /// Plans a parsed problem: IK for a pose goal, then the core planner with `ROWS` rows.
 pub fn plan_problem(problem: &Problem, guides: &[Guide], config: &PlanConfig, seed: u64) -> Result<Planned, Failure> {
+    plan_problem_on(problem, guides, config, seed, 1)
+}
+
+/// [`plan_problem`] on `threads` threads (1: on the calling thread): the same plan, bit for bit.
+pub fn plan_problem_on(
+    problem: &Problem,
+    guides: &[Guide],
+    config: &PlanConfig,
+    seed: u64,
+    threads: usize,
+) -> Result<Planned, Failure> {
+    if threads <= 1 {
+        // Four trajectories per network pass share each weight tile.
+        let mut scratches = vec![Scratch::<4>::new()];
+        return plan_with(&Serial, problem, guides, config, seed, &mut scratches);
+    }
+    let exec = Threads::new(threads).map_err(Failure::Input)?;
+    // Three per pass: the 12 rows split evenly over 2, 4 (or 3) threads.
+    let mut scratches: Vec<Scratch<3>> = (0..threads.min(ROWS)).map(|_| Scratch::new()).collect();
+    plan_with(&exec, problem, guides, config, seed, &mut scratches)
+}
+
+fn plan_with<E: Executor, const C: usize>(
+    exec: &E,
+    problem: &Problem,
+    guides: &[Guide],
+    config: &PlanConfig,
+    seed: u64,
+    scratches: &mut [Scratch<C>],
+) -> Result<Planned, Failure> {
     let ik_began = Instant::now();
     let goal = joint_goal(problem).map_err(Failure::Input)?;
     let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
-    let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<ROWS, HOST_SEARCH_NODES>::new());
     let mut paths = Box::new([[[0.0f32; 7]; HORIZON]; ROWS]);
     let mut rng = Rng::new(seed);
     let denoise_began = Instant::now();
-    denoise(
+    denoise_on(
+        exec,
         &problem.scene,
         &problem.start,
         &goal,
         guides,
         config,
         &mut rng,
-        &mut scratch,
+        scratches,
         &mut work,
         &mut paths,
     )
@@ -330,14 +379,15 @@ pub fn plan_problem(problem: &Problem, guides: &[Guide], config: &PlanConfig, se
         .map_err(|e| Failure::Input(format!("planner: {e}")))?;
     let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
     let global_began = Instant::now();
-    finish(
+    finish_on(
+        exec,
         &problem.scene,
         &problem.start,
         &goal,
         guides,
         config,
         &mut rng,
-        &mut scratch,
+        scratches,
         &mut work,
         &mut plan,
     )
@@ -478,7 +528,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let config = args.tuning.config()?;
     let timed = args.timed.request()?;
 
-    let planned = plan_problem(&problem, &guides, &config, args.seed)?;
+    let planned = plan_problem_on(&problem, &guides, &config, args.seed, args.tuning.threads()?)?;
     let total_ms = began.elapsed().as_secs_f64() * 1e3;
     let mut out = plan_document(
         &problem,

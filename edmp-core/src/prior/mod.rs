@@ -22,7 +22,7 @@ mod generated {
 }
 
 pub use generated::{DIMS, LENGTHS, LEVELS, MACS, PARAMETERS, STEPS, WEIGHT_BYTES, WEIGHTS_FNV1A};
-pub use net::{Scratch, TimeEmbedding, Trajectory, predict_noise};
+pub use net::{Scratch, TimeEmbedding, Trajectory, predict_noise, predict_noise_on};
 
 use crate::Error;
 use crate::rng::Rng;
@@ -388,6 +388,41 @@ mod tests {
         x[1][7][3] = f32::NAN;
         let got = predict_noise(&x, &time, &mut Scratch::<1>::new(), &mut batch);
         assert_eq!(got, Err(Error::NonFiniteJoint { joint: 3 }));
+    }
+
+    /// Runs items in reverse order, cut into `self.0` parts: any order must give the same bits.
+    struct Reversed(usize);
+
+    impl crate::executor::Executor for Reversed {
+        fn parts(&self) -> usize {
+            self.0
+        }
+        fn each<T: Send, F: Fn(&mut T) -> Result<(), Error> + Sync>(
+            &self,
+            items: &mut [T],
+            task: F,
+        ) -> Result<(), Error> {
+            items.iter_mut().rev().try_for_each(task)
+        }
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the UNet or its 1 MB of weights: too slow under Miri")]
+    fn noise_prediction_in_parts_gives_the_same_bits() {
+        let time = TimeEmbedding::new(40).unwrap();
+        let mut rng = Rng::new(5);
+        let mut x = [[[0.0f32; JOINTS]; HORIZON]; 12];
+        for x in &mut x {
+            initial_noise(x, &mut rng, &[0.1; JOINTS], &[0.6; JOINTS]);
+        }
+        let mut whole = [[[0.0f32; JOINTS]; HORIZON]; 12];
+        predict_noise(&x, &time, &mut std::boxed::Box::new(Scratch::<4>::new()), &mut whole).unwrap();
+        for parts in [1, 2, 3, 4, 8] {
+            let mut scratches: std::vec::Vec<Scratch<3>> = (0..parts).map(|_| Scratch::new()).collect();
+            let mut split = [[[0.0f32; JOINTS]; HORIZON]; 12];
+            predict_noise_on(&Reversed(parts), &x, &time, &mut scratches, &mut split).unwrap();
+            assert!(split == whole, "{parts} parts");
+        }
     }
 
     #[test]

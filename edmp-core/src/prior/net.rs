@@ -13,6 +13,7 @@
 
 use super::generated::{DIMS, GROUPS, KERNEL, LENGTHS, LEVELS, NET, TIME_DIM, TIME_HIDDEN, TOP_SKIP};
 use crate::Error;
+use crate::executor::{Executor, MAX_PARTS, split};
 use crate::robot::JOINTS;
 
 /// Zero columns on each side of an activation row.
@@ -264,6 +265,69 @@ pub fn predict_noise<const B: usize, const C: usize>(
     for (x, eps) in x.chunks(C).zip(eps.chunks_mut(C)) {
         forward(x, time, scratch, eps);
     }
+    if eps.iter().flatten().flatten().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::Overflow)
+    }
+}
+
+/// [`predict_noise`] with the batch cut into parts, one per scratch (at most
+/// `exec.parts()`), run by `exec`: the same bits as one scratch (every trajectory's result is
+/// independent of its batch). `x` and `eps` must have the same length; no scratch is
+/// [`Error::BadParameter`].
+pub fn predict_noise_on<E: Executor, const C: usize>(
+    exec: &E,
+    x: &[Trajectory<{ LENGTHS[0] }>],
+    time: &TimeEmbedding,
+    scratches: &mut [Scratch<C>],
+    eps: &mut [Trajectory<{ LENGTHS[0] }>],
+) -> Result<(), Error> {
+    for waypoint in x.iter().flatten() {
+        if let Some(joint) = waypoint.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFiniteJoint { joint: joint as u8 });
+        }
+    }
+    if C == 0 || scratches.is_empty() || x.len() != eps.len() {
+        return Err(Error::BadParameter);
+    }
+    struct Part<'a, const C: usize> {
+        x: &'a [Trajectory<{ LENGTHS[0] }>],
+        eps: &'a mut [Trajectory<{ LENGTHS[0] }>],
+        scratch: &'a mut Scratch<C>,
+    }
+    let lens = split(x.len(), C, exec.parts().min(scratches.len()));
+    let mut parts: heapless::Vec<Part<'_, C>, MAX_PARTS> = heapless::Vec::new();
+    let (mut x_rest, mut eps_rest) = (x, &mut eps[..]);
+    for (&len, scratch) in lens.iter().zip(scratches.iter_mut()) {
+        if len == 0 {
+            break;
+        }
+        let (Some((xp, xr)), Some((ep, er))) = (
+            x_rest.split_at_checked(len),
+            core::mem::take(&mut eps_rest).split_at_mut_checked(len),
+        ) else {
+            return Err(Error::BadParameter);
+        };
+        (x_rest, eps_rest) = (xr, er);
+        if parts
+            .push(Part {
+                x: xp,
+                eps: ep,
+                scratch,
+            })
+            .is_err()
+        {
+            return Err(Error::BadParameter);
+        }
+    }
+    exec.each(&mut parts, |part| {
+        for (x, eps) in part.x.chunks(C).zip(part.eps.chunks_mut(C)) {
+            forward(x, time, part.scratch, eps);
+        }
+        Ok(())
+    })?;
+    drop(parts);
     if eps.iter().flatten().flatten().all(|v| v.is_finite()) {
         Ok(())
     } else {
