@@ -468,3 +468,29 @@ fn bench_writes_results_summary_and_charts_and_bench_report_compares_runs() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--threads`: the same plan, bit for bit, on 1, 2 and 3 threads, for a plan the first stage
+/// solves and one that needs the global stage (bookshelf/039: its search path wins); 0 threads
+/// is bad input.
+#[test]
+fn plans_are_the_same_on_any_number_of_threads() {
+    for scene in ["examples/wall.json", "benchmarks/unseen/bookshelf/039.json"] {
+        let plan = |threads: &str| {
+            let out = edmp_host(&["plan", scene, "--candidates", "--threads", threads]);
+            assert!(out.status.code().is_some_and(|c| c <= 1), "{}", String::from_utf8_lossy(&out.stderr));
+            let mut doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            doc.as_object_mut().unwrap().remove("timing_ms");
+            doc
+        };
+        let one = plan("1");
+        assert_eq!(plan("2"), one, "{scene}: 2 threads");
+        assert_eq!(plan("3"), one, "{scene}: 3 threads");
+        if scene.contains("bookshelf") {
+            assert_ne!(one["stage"], "diffusion", "the global stage ran");
+        }
+    }
+    let out = edmp_host(&["plan", "examples/wall.json", "--threads", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--threads"));
+    assert!(out.stdout.is_empty());
+}
