@@ -477,7 +477,11 @@ fn plans_are_the_same_on_any_number_of_threads() {
     for scene in ["examples/wall.json", "benchmarks/unseen/bookshelf/039.json"] {
         let plan = |threads: &str| {
             let out = edmp_host(&["plan", scene, "--candidates", "--threads", threads]);
-            assert!(out.status.code().is_some_and(|c| c <= 1), "{}", String::from_utf8_lossy(&out.stderr));
+            assert!(
+                out.status.code().is_some_and(|c| c <= 1),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
             let mut doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
             doc.as_object_mut().unwrap().remove("timing_ms");
             doc
