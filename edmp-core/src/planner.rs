@@ -427,6 +427,7 @@ pub fn polish<const B: usize, const N: usize>(
 /// and boxes (the first stage's and the global stage's guidance alike). A guide whose rows stop
 /// moving is settled and skipped for the rest of the steps: at a fixed `t` its next step would
 /// be the same no-op, so this saves work and changes no bit ([`guide_step`]).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn guide_steps<E: Executor, const B: usize, const N: usize>(
     exec: &E,
     scene: &Scene<N>,

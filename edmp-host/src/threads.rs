@@ -15,8 +15,8 @@ pub struct Threads {
     pool: Arc<rayon::ThreadPool>,
 }
 
-impl std::fmt::Debug for Threads {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl core::fmt::Debug for Threads {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("Threads")
             .field("threads", &self.pool.current_num_threads())
             .finish()
