@@ -40,6 +40,22 @@ impl Executor for Serial {
     }
 }
 
+/// For tests: runs items in reverse order, cut into `self.0` parts (any order must give the same
+/// bits).
+#[cfg(test)]
+pub(crate) struct Reversed(pub usize);
+
+#[cfg(test)]
+impl Executor for Reversed {
+    fn parts(&self) -> usize {
+        self.0
+    }
+
+    fn each<T: Send, F: Fn(&mut T) -> Result<(), Error> + Sync>(&self, items: &mut [T], task: F) -> Result<(), Error> {
+        items.iter_mut().rev().try_for_each(task)
+    }
+}
+
 /// `n` items cut into at most `parts` contiguous runs of whole groups of `group` items: the
 /// length of each run (0 past the last). `group` 0 counts as 1.
 pub(crate) fn split(n: usize, group: usize, parts: usize) -> [usize; MAX_PARTS] {

@@ -360,22 +360,6 @@ mod tests {
         }
     }
 
-    /// Runs items in reverse order, cut into `self.0` parts.
-    struct Reversed(usize);
-
-    impl Executor for Reversed {
-        fn parts(&self) -> usize {
-            self.0
-        }
-        fn each<T: Send, F: Fn(&mut T) -> Result<(), Error> + Sync>(
-            &self,
-            items: &mut [T],
-            task: F,
-        ) -> Result<(), Error> {
-            items.iter_mut().rev().try_for_each(task)
-        }
-    }
-
     #[test]
     #[cfg_attr(miri, ignore = "guidance steps over a batch: too slow under Miri")]
     fn guides_in_parts_step_the_same_bits() {
@@ -409,7 +393,7 @@ mod tests {
             let mut flags = [false; 12];
             for _ in 0..3 {
                 guide_step_on(
-                    &Reversed(parts),
+                    &crate::executor::Reversed(parts),
                     &scene,
                     &mut rows,
                     &mut grads,

@@ -390,22 +390,6 @@ mod tests {
         assert_eq!(got, Err(Error::NonFiniteJoint { joint: 3 }));
     }
 
-    /// Runs items in reverse order, cut into `self.0` parts: any order must give the same bits.
-    struct Reversed(usize);
-
-    impl crate::executor::Executor for Reversed {
-        fn parts(&self) -> usize {
-            self.0
-        }
-        fn each<T: Send, F: Fn(&mut T) -> Result<(), Error> + Sync>(
-            &self,
-            items: &mut [T],
-            task: F,
-        ) -> Result<(), Error> {
-            items.iter_mut().rev().try_for_each(task)
-        }
-    }
-
     #[test]
     #[cfg_attr(miri, ignore = "the UNet or its 1 MB of weights: too slow under Miri")]
     fn noise_prediction_in_parts_gives_the_same_bits() {
@@ -420,7 +404,7 @@ mod tests {
         for parts in [1, 2, 3, 4, 8] {
             let mut scratches: std::vec::Vec<Scratch<3>> = (0..parts).map(|_| Scratch::new()).collect();
             let mut split = [[[0.0f32; JOINTS]; HORIZON]; 12];
-            predict_noise_on(&Reversed(parts), &x, &time, &mut scratches, &mut split).unwrap();
+            predict_noise_on(&crate::executor::Reversed(parts), &x, &time, &mut scratches, &mut split).unwrap();
             assert!(split == whole, "{parts} parts");
         }
     }
