@@ -8,7 +8,7 @@
 use edmp_core::checker::CheckConfig;
 use edmp_core::geometry::{BoxFrame, CylinderBox};
 use edmp_core::global::GlobalConfig;
-use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES};
 use edmp_core::planner::{GuidanceSchedule, PlanConfig, RefineStop, Workspace, plan};
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
@@ -101,8 +101,10 @@ fuzz_target!(|data: &[u8]| {
             })
         },
         refine_stop: None,
+        refine_guide: None,
+        step_control: false,
     };
-    let guides = &EDMP_GUIDES[..[1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)]];
+    let count = [1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)];
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<12>::new());
     let seed = u64::from(r.byte());
@@ -113,6 +115,17 @@ fuzz_target!(|data: &[u8]| {
             free: r.byte() % 14,
         });
     }
+    // The optimizer's ablations: step-size control, the clearance refinement, a smoothness term.
+    let extra = r.byte();
+    config.step_control = extra & 1 != 0;
+    if extra & 2 != 0 {
+        config.refine_guide = Some(CLEARANCE_GUIDE);
+    }
+    let mut table = EDMP_GUIDES;
+    for g in &mut table {
+        g.smooth = if extra & 4 != 0 { 0.1 } else { 0.0 };
+    }
+    let guides = &table[..count];
     if let Ok(p) = plan(
         &scene,
         &start,
