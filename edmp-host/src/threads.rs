@@ -1,7 +1,7 @@
 //! The core's [`Executor`] on several cores (`--threads`): a rayon pool runs the items the
 //! planner hands over (parts of the network's batch, groups of guides, the refinement's row
 //! checks). Every item's result is its own, so a plan is the same, bit for bit, on any number of
-//! threads (`tests/cli.rs` and the core's tests check it).
+//! threads (`edmp-host/tests/cli.rs` and the core's tests check it).
 
 use edmp_core::Error;
 use edmp_core::executor::{Executor, MAX_PARTS};
