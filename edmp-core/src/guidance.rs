@@ -65,12 +65,7 @@ pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
     if exec.parts() <= 1 {
         return step_rows(scene, rows, grads, guides, t, rule, settled, None);
     }
-    if guides.is_empty() || !rows.len().is_multiple_of(guides.len()) || grads.len() != rows.len() {
-        return Err(Error::BadParameter);
-    }
-    if !settled.is_empty() && settled.len() != guides.len() {
-        return Err(Error::BadParameter);
-    }
+    check_batch(rows.len(), grads.len(), guides.len(), settled.len())?;
     struct Part<'a, const H: usize> {
         guides: &'a [Guide],
         rows: &'a mut [[Joints<f32>; H]],
@@ -104,6 +99,17 @@ pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
     exec.each(&mut parts, |p| {
         step_rows(scene, p.rows, p.grads, p.guides, t, rule, p.settled, None)
     })
+}
+
+/// The batch's shape: rows split evenly over the guides, one gradient per row, and one settled
+/// flag per guide or none.
+fn check_batch(rows: usize, grads: usize, guides: usize, settled: usize) -> Result<(), Error> {
+    let even = guides > 0 && rows.is_multiple_of(guides) && grads == rows;
+    if even && (settled == 0 || settled == guides) {
+        Ok(())
+    } else {
+        Err(Error::BadParameter)
+    }
 }
 
 /// How [`guide_step`] moves rows: the per-joint step limit and how the costs box things.
@@ -171,10 +177,8 @@ fn step_rows<const H: usize, const N: usize>(
     if step_limit.is_nan() || step_limit <= 0.0 {
         return Err(Error::BadParameter);
     }
-    if guides.is_empty() || !rows.len().is_multiple_of(guides.len()) || grads.len() != rows.len() || H < 3 {
-        return Err(Error::BadParameter);
-    }
-    if !settled.is_empty() && settled.len() != guides.len() {
+    check_batch(rows.len(), grads.len(), guides.len(), settled.len())?;
+    if H < 3 {
         return Err(Error::BadParameter);
     }
     if guides.iter().any(|g| !(g.smooth.is_finite() && g.smooth >= 0.0)) {
