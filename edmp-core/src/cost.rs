@@ -314,6 +314,50 @@ impl Pulls {
     }
 }
 
+/// What one evaluation of a row's cost leaves for the next one at the same [`CostConfig`]: the
+/// costs' units (sv: the segments, unit `u` from waypoint `u` to `u + 1`; iv: the interior
+/// waypoints) that reached no obstacle box, and the waypoints that have moved since.
+///
+/// A unit that reached nothing and none of whose waypoints moved a bit reaches nothing again:
+/// [`trajectory_cost_memo`] skips it, and its waypoints' FK when no other unit needs them. The
+/// result is the same bits as a full evaluation (such a unit adds no volume and no pull).
+/// Between the guidance steps at one `t` most waypoints do not move (a zero gradient moves
+/// nothing), so most of a row's segments are skipped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CostMemo {
+    /// The configuration of the last evaluation; `None`: nothing is known (every unit runs).
+    config: Option<CostConfig>,
+    /// Bit `u`: unit `u` reached no obstacle box at the last evaluation.
+    quiet: u64,
+    /// Bit `w`: waypoint `w` changed since the last evaluation ([`CostMemo::moved`]).
+    moved: u64,
+}
+
+impl CostMemo {
+    /// Nothing known: the next evaluation runs every unit.
+    pub const NONE: Self = Self {
+        config: None,
+        quiet: 0,
+        moved: 0,
+    };
+
+    /// Waypoints whose bits changed since the last evaluation (bit `w`: waypoint `w`); the caller
+    /// reports every change of the row it evaluates, or calls [`CostMemo::forget`].
+    pub fn moved(&mut self, waypoints: u64) {
+        self.moved |= waypoints;
+    }
+
+    /// Forget the last evaluation (the row or the scene changed in a way not reported).
+    pub fn forget(&mut self) {
+        *self = Self::NONE;
+    }
+
+    /// Whether unit `u`, whose waypoints are the bits of `span`, can be skipped.
+    fn skips(&self, u: usize, span: u64) -> bool {
+        u < 64 && self.quiet & (1 << u) != 0 && self.moved & span == 0
+    }
+}
+
 /// EDMP's cost of one trajectory of `H` waypoints in `scene`. With `gradient`, also writes
 /// `∂cost/∂waypoint` for every waypoint (iv: zero at the two ends; sv: the ends get theirs too,
 /// the caller decides whether to apply them).
@@ -325,6 +369,19 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     trajectory: &[Joints<f32>; H],
     config: &CostConfig,
     gradient: Option<&mut [Joints<f32>; H]>,
+) -> Result<f32, Error> {
+    trajectory_cost_memo(scene, trajectory, config, gradient, None)
+}
+
+/// [`trajectory_cost`] that skips what `memo` shows cannot reach an obstacle box, and updates
+/// `memo` for the next evaluation of the same row in the same scene. The same bits as
+/// [`trajectory_cost`]. Trajectories of more than 64 waypoints are evaluated in full.
+pub fn trajectory_cost_memo<const H: usize, const N: usize>(
+    scene: &Scene<N>,
+    trajectory: &[Joints<f32>; H],
+    config: &CostConfig,
+    gradient: Option<&mut [Joints<f32>; H]>,
+    memo: Option<&mut CostMemo>,
 ) -> Result<f32, Error> {
     let Inflation { clearance, expansion } = config.inflation;
     if !(clearance.is_finite() && expansion.is_finite() && clearance >= 0.0 && expansion >= 0.0) {
@@ -367,28 +424,80 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     }
     radii[HELD] = held.map_or(0.0, |(_, half)| radius_of(&half));
 
+    // What the last evaluation of this row left: only for the same configuration.
+    let memo = memo.filter(|_| H <= 64);
+    let known = match &memo {
+        Some(m) if m.config == Some(*config) => **m,
+        _ => CostMemo::NONE,
+    };
+    let swept_kind = config.kind == CostKind::Swept;
+    // Unit `u` of waypoint `w`'s units: sv segments `w − 1` and `w`; iv waypoint `w` itself.
+    let runs = |u: usize| -> bool {
+        if swept_kind {
+            u + 1 < H && !known.skips(u, 0b11 << u)
+        } else {
+            u > 0 && u + 1 < H && !known.skips(u, 1 << u)
+        }
+    };
+    let needed = |w: usize| -> bool {
+        if swept_kind {
+            (w > 0 && runs(w - 1)) || runs(w)
+        } else {
+            runs(w)
+        }
+    };
+    let mut quiet = 0u64;
+
     let mut gradient = gradient;
     let mut total = 0.0f32;
-    // Two waypoints in flight, swapped by reference: `before` is waypoint w − 1.
+    // Two waypoints in flight, swapped by reference: `before` is waypoint w − 1. A waypoint no
+    // unit needs is not placed (its flag is false) and its gradient is zero.
     let mut pair = [Waypoint::EMPTY; 2];
     let [before, current] = &mut pair;
     let (mut before, mut current) = (before, current);
+    let (mut before_placed, mut current_placed);
+    before_placed = false;
     for (w, q) in trajectory.iter().enumerate() {
-        // The scene's finger opening places the finger boxes; for the adjoint it is a constant.
-        forward_into(q, scene.gripper(), &mut current.k)?;
-        current.place(held, &radii);
-        match config.kind {
-            CostKind::Intersection if w > 0 && w + 1 < H => total += intersection(current, obstacles),
-            CostKind::Swept if w > 0 => total += swept(before, current, obstacles),
-            _ => {}
+        current_placed = needed(w);
+        if current_placed {
+            // The scene's finger opening places the finger boxes; for the adjoint it is a constant.
+            forward_into(q, scene.gripper(), &mut current.k)?;
+            current.place(held, &radii);
+        }
+        // The unit that ends at this waypoint: sv the segment into it, iv the waypoint itself.
+        let unit = if swept_kind { w.checked_sub(1) } else { Some(w) };
+        if let Some(u) = unit.filter(|&u| u < H.saturating_sub(1) && (swept_kind || u > 0)) {
+            let hit = if runs(u) {
+                let (v, hit) = if swept_kind {
+                    swept(before, current, obstacles)
+                } else {
+                    intersection(current, obstacles)
+                };
+                total += v;
+                hit
+            } else {
+                // Skipped: it was quiet and nothing of it moved.
+                false
+            };
+            if !hit && u < 64 {
+                quiet |= 1 << u;
+            }
         }
         if w > 0 {
-            finish(before, w - 1, gradient.as_deref_mut())?;
+            finish(before, before_placed, w - 1, gradient.as_deref_mut())?;
         }
         core::mem::swap(&mut before, &mut current);
+        before_placed = current_placed;
     }
     if H > 0 {
-        finish(before, H - 1, gradient)?;
+        finish(before, before_placed, H - 1, gradient)?;
+    }
+    if let Some(m) = memo {
+        *m = CostMemo {
+            config: Some(*config),
+            quiet,
+            moved: 0,
+        };
     }
     if total.is_finite() {
         Ok(total)
@@ -398,11 +507,16 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
 }
 
 /// Writes waypoint `w`'s joint gradient once its corners' gradients are final.
-fn finish<const H: usize>(done: &Waypoint, w: usize, gradient: Option<&mut [Joints<f32>; H]>) -> Result<(), Error> {
+fn finish<const H: usize>(
+    done: &Waypoint,
+    placed: bool,
+    w: usize,
+    gradient: Option<&mut [Joints<f32>; H]>,
+) -> Result<(), Error> {
     let Some(slot) = gradient.and_then(|g| g.get_mut(w)) else {
         return Ok(());
     };
-    *slot = if done.pulls.touched != 0 {
+    *slot = if placed && done.pulls.touched != 0 {
         // Finite inputs whose volumes' gradients overflowed are an overflow, not bad input.
         waypoint_gradient(done).map_err(|e| match e {
             Error::NonFiniteGradient => Error::Overflow,
@@ -492,8 +606,10 @@ fn slots_of(mut mask: u16) -> impl Iterator<Item = usize> {
 }
 
 /// Intersection volume of one interior waypoint's boxes; adds its gradient to the waypoint.
-fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
+/// Also whether any pair overlapped (added a volume and pulls).
+fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> (f32, bool) {
     let mut total = 0.0;
+    let mut hit = false;
     let Waypoint {
         boxes,
         balls,
@@ -511,6 +627,7 @@ fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
             let (aabb, arg) = b.aabb_in(o, c);
             if let Some((v, d_min, d_max)) = volume_with_gradient(&aabb, &o.bounds) {
                 total += v;
+                hit = true;
                 for k in 0..3 {
                     pulls.add(s, arg[0][k], o, k, d_min[k]);
                     pulls.add(s, arg[1][k], o, k, d_max[k]);
@@ -518,13 +635,15 @@ fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
             }
         }
     }
-    total
+    (total, hit)
 }
 
 /// Swept volume of the segment between two waypoints; each swept bound's share of the
-/// gradient goes to the end that set it (ties to the first end).
-fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
+/// gradient goes to the end that set it (ties to the first end). Also whether any pair
+/// overlapped (added a volume and pulls).
+fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> (f32, bool) {
     let mut total = 0.0;
+    let mut hit = false;
     // In an obstacle's frame the union of the two ends' AABBs lies in a ball around the
     // midpoint of radius |ca − cb| / 2 + √3·|half| (not in the world-axis union of the ends'
     // balls: the frame may be turned).
@@ -548,7 +667,7 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
         hull = Some(hull.map_or(r, |h| h.union(&r)));
     }
     let Some(hull) = hull else {
-        return 0.0;
+        return (0.0, false);
     };
     let (boxes_a, pulls_a, boxes_b, pulls_b) = (&a.boxes, &mut a.pulls, &b.boxes, &mut b.pulls);
     for o in obstacles.iter().filter(|o| overlaps(&hull, &o.world)) {
@@ -568,6 +687,7 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
             let ((la, arg_a), (lb, arg_b)) = (box_a.aabb_in(o, ca), box_b.aabb_in(o, cb));
             if let Some((v, d_min, d_max)) = volume_with_gradient(&la.union(&lb), &o.bounds) {
                 total += v;
+                hit = true;
                 for k in 0..3 {
                     if lb.min[k] < la.min[k] {
                         pulls_b.add(s, arg_b[0][k], o, k, d_min[k]);
@@ -583,7 +703,7 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> f32 {
             }
         }
     }
-    total
+    (total, hit)
 }
 
 /// Joint gradient of one waypoint from the gradient on its boxes' corners: each corner is a
@@ -705,6 +825,81 @@ mod tests {
             trajectory_cost(&scene, &traj, &c, Some(&mut [[0.0; 7]; 5])),
             Err(Error::NonFiniteJoint { joint: 2 })
         );
+    }
+
+    /// A sweep of joints 0 and 1 past three boxes, some waypoints in contact.
+    fn sweep<const H: usize>() -> [Joints<f32>; H] {
+        core::array::from_fn(|w| {
+            let s = w as f32 / (H - 1) as f32;
+            let mut q = READY;
+            q[0] = -1.2 + 2.4 * s;
+            q[1] = -0.785 + 0.6 * s;
+            q
+        })
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "hundreds of trajectory costs: too slow")]
+    fn the_memo_gives_the_bits_of_a_full_evaluation() {
+        let mut scene = Scene::<4>::new();
+        for (center, half) in [
+            ([0.5, 0.0, 0.4], [0.05, 0.3, 0.05]),
+            ([0.2, 0.45, 0.5], [0.1, 0.02, 0.2]),
+            ([0.3, -0.5, 0.1], [0.2, 0.1, 0.1]),
+        ] {
+            scene.push(Obstacle::cuboid(center, half, ID).unwrap()).unwrap();
+        }
+        let mut rng = crate::rng::Rng::new(11);
+        for kind in [CostKind::Intersection, CostKind::Swept] {
+            let mut traj: [Joints<f32>; 16] = sweep();
+            let mut memo = CostMemo::NONE;
+            let mut skipped_some = false;
+            for step in 0..60 {
+                // Every 20 steps the inflation changes: the memo must notice by itself.
+                let mut c = config(kind);
+                c.inflation.clearance = 0.01 * (step / 20) as f32;
+                let (mut full, mut memoed) = ([[0.0; 7]; 16], [[9.0; 7]; 16]);
+                let want = trajectory_cost(&scene, &traj, &c, Some(&mut full)).unwrap();
+                let quiet_before = memo.quiet;
+                let got = trajectory_cost_memo(&scene, &traj, &c, Some(&mut memoed), Some(&mut memo)).unwrap();
+                assert_eq!(got.to_bits(), want.to_bits(), "{kind:?} step {step}");
+                let bits = |g: &[Joints<f32>; 16]| g.map(|q| q.map(f32::to_bits));
+                assert_eq!(bits(&memoed), bits(&full), "{kind:?} step {step}");
+                skipped_some |= quiet_before != 0 && step % 20 != 0;
+                // Move a few waypoints (those with a gradient, and now and then a random one).
+                let mut moved = 0u64;
+                for (w, (q, g)) in traj.iter_mut().zip(&full).enumerate().skip(1).take(14) {
+                    let random = rng.below(8) == 0;
+                    if g.iter().any(|&v| v != 0.0) || random {
+                        for (qj, gj) in q.iter_mut().zip(g) {
+                            *qj -= 0.05 * gj.clamp(-1.0, 1.0) + if random { 0.01 } else { 0.0 };
+                        }
+                        moved |= 1 << w;
+                    }
+                }
+                memo.moved(moved);
+            }
+            assert!(skipped_some, "{kind:?}: the memo never had a quiet unit to skip");
+        }
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "trajectory costs: too slow")]
+    fn a_forgotten_memo_runs_everything() {
+        let mut scene = Scene::<1>::new();
+        scene
+            .push(Obstacle::cuboid([0.5, 0.0, 0.4], [0.05, 0.3, 0.05], ID).unwrap())
+            .unwrap();
+        let c = config(CostKind::Swept);
+        let mut traj: [Joints<f32>; 8] = sweep();
+        let mut memo = CostMemo::NONE;
+        trajectory_cost_memo(&scene, &traj, &c, None, Some(&mut memo)).unwrap();
+        // A change the memo is not told of, then forgotten: the full cost again.
+        traj[3][0] += 0.3;
+        memo.forget();
+        let want = trajectory_cost(&scene, &traj, &c, None).unwrap();
+        let got = trajectory_cost_memo(&scene, &traj, &c, None, Some(&mut memo)).unwrap();
+        assert_eq!(got.to_bits(), want.to_bits());
     }
 
     #[test]

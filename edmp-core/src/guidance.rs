@@ -8,7 +8,7 @@
 //! limit per joint keeps the unnormalized guides (whose step is the raw gradient times ~2)
 //! from throwing a waypoint across the workspace where the costs are steep.
 
-use crate::cost::{CostConfig, trajectory_cost};
+use crate::cost::{CostConfig, CostMemo, trajectory_cost_memo};
 use crate::error::Error;
 use crate::executor::{Executor, MAX_PARTS, split};
 use crate::geometry::{BoxFrame, CylinderBox};
@@ -46,11 +46,16 @@ pub fn guide_step<const H: usize, const N: usize>(
         cylinder,
         frame,
     };
-    step_rows(scene, rows, grads, guides, t, &rule, settled, None)
+    step_rows(scene, rows, grads, guides, t, &rule, settled, &mut [], None)
 }
 
 /// [`guide_step`] with the guides cut into groups run by `exec` (each group steps its own
 /// rows: the same bits as one call).
+///
+/// `memos` is empty or holds one [`CostMemo`] per row, which lets a row's cost skip the
+/// segments that reached nothing at the last step and have not moved since (the same bits).
+/// Keep them for the steps at one `t` and start them at [`CostMemo::NONE`] whenever the rows
+/// change otherwise (a denoising step) or the scene does.
 #[allow(clippy::too_many_arguments)]
 pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
     exec: &E,
@@ -61,51 +66,56 @@ pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
     t: u16,
     rule: &StepRule,
     settled: &mut [bool],
+    memos: &mut [CostMemo],
 ) -> Result<(), Error> {
     if exec.parts() <= 1 {
-        return step_rows(scene, rows, grads, guides, t, rule, settled, None);
+        return step_rows(scene, rows, grads, guides, t, rule, settled, memos, None);
     }
-    check_batch(rows.len(), grads.len(), guides.len(), settled.len())?;
+    check_batch(rows.len(), grads.len(), guides.len(), settled.len(), memos.len())?;
     struct Part<'a, const H: usize> {
         guides: &'a [Guide],
         rows: &'a mut [[Joints<f32>; H]],
         grads: &'a mut [[Joints<f32>; H]],
         settled: &'a mut [bool],
+        memos: &'a mut [CostMemo],
     }
     let per_guide = rows.len() / guides.len();
     let mut parts: heapless::Vec<Part<'_, H>, MAX_PARTS> = heapless::Vec::new();
-    let (mut g_rest, mut r_rest, mut d_rest, mut s_rest) = (guides, rows, grads, settled);
+    let (mut g_rest, mut r_rest, mut d_rest, mut s_rest, mut m_rest) = (guides, rows, grads, settled, memos);
     for &len in split(guides.len(), 1, exec.parts()).iter().filter(|&&l| l > 0) {
         let (rows_len, settled_len) = ((len * per_guide).min(r_rest.len()), len.min(s_rest.len()));
-        let (Some((g, gr)), Some((r, rr)), Some((d, dr)), Some((s, sr))) = (
+        let memos_len = rows_len.min(m_rest.len());
+        let (Some((g, gr)), Some((r, rr)), Some((d, dr)), Some((s, sr)), Some((m, mr))) = (
             g_rest.split_at_checked(len),
             core::mem::take(&mut r_rest).split_at_mut_checked(rows_len),
             core::mem::take(&mut d_rest).split_at_mut_checked(rows_len),
             core::mem::take(&mut s_rest).split_at_mut_checked(settled_len),
+            core::mem::take(&mut m_rest).split_at_mut_checked(memos_len),
         ) else {
             return Err(Error::BadParameter);
         };
-        (g_rest, r_rest, d_rest, s_rest) = (gr, rr, dr, sr);
+        (g_rest, r_rest, d_rest, s_rest, m_rest) = (gr, rr, dr, sr, mr);
         let part = Part {
             guides: g,
             rows: r,
             grads: d,
             settled: s,
+            memos: m,
         };
         if parts.push(part).is_err() {
             return Err(Error::BadParameter);
         }
     }
     exec.each(&mut parts, |p| {
-        step_rows(scene, p.rows, p.grads, p.guides, t, rule, p.settled, None)
+        step_rows(scene, p.rows, p.grads, p.guides, t, rule, p.settled, p.memos, None)
     })
 }
 
-/// The batch's shape: rows split evenly over the guides, one gradient per row, and one settled
-/// flag per guide or none.
-fn check_batch(rows: usize, grads: usize, guides: usize, settled: usize) -> Result<(), Error> {
+/// The batch's shape: rows split evenly over the guides, one gradient per row, one settled
+/// flag per guide or none, one memo per row or none.
+fn check_batch(rows: usize, grads: usize, guides: usize, settled: usize, memos: usize) -> Result<(), Error> {
     let even = guides > 0 && rows.is_multiple_of(guides) && grads == rows;
-    if even && (settled == 0 || settled == guides) {
+    if even && (settled == 0 || settled == guides) && (memos == 0 || memos == rows) {
         Ok(())
     } else {
         Err(Error::BadParameter)
@@ -158,7 +168,7 @@ pub fn guide_step_controlled<const H: usize, const N: usize>(
     if control.saved.len() != rows.len() || control.best.len() != guides.len() || control.scale.len() != guides.len() {
         return Err(Error::BadParameter);
     }
-    step_rows(scene, rows, grads, guides, t, rule, settled, Some(control))
+    step_rows(scene, rows, grads, guides, t, rule, settled, &mut [], Some(control))
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -171,13 +181,16 @@ fn step_rows<const H: usize, const N: usize>(
     t: u16,
     rule: &StepRule,
     settled: &mut [bool],
+    memos: &mut [CostMemo],
     mut control: Option<&mut StepControl<'_, H>>,
 ) -> Result<(), Error> {
     let step_limit = rule.step_limit;
     if step_limit.is_nan() || step_limit <= 0.0 {
         return Err(Error::BadParameter);
     }
-    check_batch(rows.len(), grads.len(), guides.len(), settled.len())?;
+    check_batch(rows.len(), grads.len(), guides.len(), settled.len(), memos.len())?;
+    // Step-size control moves rows back: its steps are not reported to the memos.
+    let memos = if control.is_some() { &mut [][..] } else { memos };
     if H < 3 {
         return Err(Error::BadParameter);
     }
@@ -188,12 +201,14 @@ fn step_rows<const H: usize, const N: usize>(
     if per_guide == 0 {
         return Ok(());
     }
+    let mut memos = memos.chunks_mut(per_guide);
     for (g, ((guide, rows), grads)) in guides
         .iter()
         .zip(rows.chunks_mut(per_guide))
         .zip(grads.chunks_mut(per_guide))
         .enumerate()
     {
+        let memos = memos.next().unwrap_or(&mut []);
         if settled.get(g).copied().unwrap_or(false) {
             continue;
         }
@@ -205,9 +220,9 @@ fn step_rows<const H: usize, const N: usize>(
         };
         let mut norm2 = 0.0f32;
         let mut cost = 0.0f32;
-        for (row, grad) in rows.iter().zip(grads.iter_mut()) {
+        for (r, (row, grad)) in rows.iter().zip(grads.iter_mut()).enumerate() {
             let clipped = row.map(|q| core::array::from_fn(|j| q[j].clamp(PANDA.hard_lower[j], PANDA.hard_upper[j])));
-            cost += trajectory_cost(scene, &clipped, &config, Some(grad))?;
+            cost += trajectory_cost_memo(scene, &clipped, &config, Some(grad), memos.get_mut(r))?;
             norm2 += grad[1..H - 1].iter().flatten().map(|g| g * g).sum::<f32>();
         }
         let mut multiplier = 1.0f32;
@@ -250,7 +265,7 @@ fn step_rows<const H: usize, const N: usize>(
         };
         let smooth = guide.smooth * multiplier;
         let mut moved = false;
-        for (row, grad) in rows.iter_mut().zip(grads.iter()) {
+        for (r, (row, grad)) in rows.iter_mut().zip(grads.iter()).enumerate() {
             // The smoothness term acts only where the collision cost pulls: a row it leaves
             // alone stays put (and its guide can settle).
             let pulled = smooth > 0.0 && grad[1..H - 1].iter().flatten().any(|&v| v != 0.0);
@@ -259,12 +274,25 @@ fn step_rows<const H: usize, const N: usize>(
             } else {
                 [[0.0; JOINTS]; H]
             };
-            for ((q, gq), bq) in row[1..H - 1].iter_mut().zip(&grad[1..H - 1]).zip(&bend[1..H - 1]) {
+            let mut waypoints_moved = 0u64;
+            for (w, ((q, gq), bq)) in row[1..H - 1]
+                .iter_mut()
+                .zip(&grad[1..H - 1])
+                .zip(&bend[1..H - 1])
+                .enumerate()
+            {
+                let mut here = false;
                 for ((qj, gj), bj) in q.iter_mut().zip(gq).zip(bq) {
                     let next = *qj - (scale * gj + smooth * bj).clamp(-step_limit, step_limit);
-                    moved |= next.to_bits() != qj.to_bits();
+                    here |= next.to_bits() != qj.to_bits();
                     *qj = next;
                 }
+                // Waypoint w + 1; a row longer than 64 waypoints is never skipped by its memo.
+                waypoints_moved |= u64::from(here).checked_shl(w as u32 + 1).unwrap_or(0);
+                moved |= here;
+            }
+            if let Some(memo) = memos.get_mut(r) {
+                memo.moved(waypoints_moved);
             }
             if row.iter().flatten().any(|v| !v.is_finite()) {
                 return Err(Error::Overflow);
@@ -297,7 +325,7 @@ pub fn bending_gradient<const H: usize>(row: &[Joints<f32>; H]) -> [Joints<f32>;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cost::CostKind;
+    use crate::cost::{CostKind, trajectory_cost};
     use crate::guides::EDMP_GUIDES;
     use crate::scene::Obstacle;
 
@@ -366,7 +394,7 @@ mod tests {
 
     #[test]
     #[cfg_attr(miri, ignore = "guidance steps over a batch: too slow under Miri")]
-    fn guides_in_parts_step_the_same_bits() {
+    fn guides_in_parts_and_with_memos_step_the_same_bits() {
         let scene = scene();
         let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
         let b = [1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];
@@ -378,7 +406,8 @@ mod tests {
         let mut whole = [line(a, b); 24];
         let mut grads = [[[0.0; 7]; H]; 24];
         let mut settled = [false; 12];
-        for _ in 0..3 {
+        // Without memos: every segment of every row costed at every step.
+        for _ in 0..6 {
             step_rows(
                 &scene,
                 &mut whole,
@@ -387,28 +416,38 @@ mod tests {
                 30,
                 &rule,
                 &mut settled,
+                &mut [],
                 None,
             )
             .unwrap();
         }
         assert!(whole != [line(a, b); 24], "the guides moved the rows");
-        for parts in [2, 3, 5, 8] {
-            let mut rows = [line(a, b); 24];
-            let mut flags = [false; 12];
-            for _ in 0..3 {
-                guide_step_on(
-                    &crate::executor::Reversed(parts),
-                    &scene,
-                    &mut rows,
-                    &mut grads,
-                    &EDMP_GUIDES,
-                    30,
-                    &rule,
-                    &mut flags,
-                )
-                .unwrap();
+        for parts in [1, 2, 3, 5, 8] {
+            for with_memos in [false, true] {
+                let mut rows = [line(a, b); 24];
+                let mut flags = [false; 12];
+                let mut memos = [CostMemo::NONE; 24];
+                let memos = if with_memos { &mut memos[..] } else { &mut [][..] };
+                for _ in 0..6 {
+                    guide_step_on(
+                        &crate::executor::Reversed(parts),
+                        &scene,
+                        &mut rows,
+                        &mut grads,
+                        &EDMP_GUIDES,
+                        30,
+                        &rule,
+                        &mut flags,
+                        memos,
+                    )
+                    .unwrap();
+                }
+                let rows_bits = |r: &[[Joints<f32>; H]; 24]| r.map(|x| x.map(|q| q.map(f32::to_bits)));
+                assert!(
+                    rows_bits(&rows) == rows_bits(&whole) && flags == settled,
+                    "{parts} parts, memos: {with_memos}"
+                );
             }
-            assert!(rows == whole && flags == settled, "{parts} parts");
         }
     }
 

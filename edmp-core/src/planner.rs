@@ -12,7 +12,7 @@
 //! stage adds a bounded amount on top ([`crate::global`] states it).
 
 use crate::checker::{CheckConfig, check_trajectory, check_trajectory_from};
-use crate::cost::{CostConfig, CostKind, trajectory_cost};
+use crate::cost::{CostConfig, CostKind, CostMemo, trajectory_cost};
 use crate::error::Error;
 use crate::executor::{Executor, Serial};
 use crate::geometry::{BoxFrame, CylinderBox, Inflation};
@@ -440,8 +440,9 @@ pub(crate) fn guide_steps<E: Executor, const B: usize, const N: usize>(
 ) -> Result<(), Error> {
     let mut settled = [false; B];
     let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
+    let mut memos = [CostMemo::NONE; B];
     for _ in 0..steps {
-        guide_once(exec, scene, paths, grads, guides, t, config, settled)?;
+        guide_once(exec, scene, paths, grads, guides, t, config, settled, &mut memos)?;
         if settled.iter().all(|&s| s) {
             break;
         }
@@ -460,13 +461,14 @@ fn guide_once<E: Executor, const B: usize, const N: usize>(
     t: u16,
     config: &PlanConfig,
     settled: &mut [bool],
+    memos: &mut [CostMemo; B],
 ) -> Result<(), Error> {
     let rule = StepRule {
         step_limit: config.step_limit,
         cylinder: config.cylinder,
         frame: config.frame,
     };
-    guide_step_on(exec, scene, paths, grads, guides, t, &rule, settled)
+    guide_step_on(exec, scene, paths, grads, guides, t, &rule, settled, memos)
 }
 
 /// The refinement: `steps` gradient steps of every row's guide at t = 1 (or of
@@ -511,6 +513,8 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
     let per_guide = B / guides.len();
     let mut settled = [false; B];
     let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
+    // One t (1) and rows moved only by the guides: each row's memo holds for the whole refinement.
+    let mut memos = [CostMemo::NONE; B];
     let (mut best, mut scale) = ([f32::INFINITY; B], [1.0f32; B]);
     let rule = StepRule {
         step_limit: config.step_limit,
@@ -558,7 +562,7 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
             };
             guide_step_controlled(scene, paths, grads, guides, 1, &rule, settled, &mut control)?;
         } else {
-            guide_once(exec, scene, paths, grads, guides, 1, config, settled)?;
+            guide_once(exec, scene, paths, grads, guides, 1, config, settled, &mut memos)?;
         }
         if settled.iter().all(|&s| s) {
             break;
