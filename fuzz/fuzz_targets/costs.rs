@@ -1,11 +1,12 @@
 //! Arbitrary scenes, trajectories and cost settings (raw f32 bits: NaN, infinities, huge and
 //! tiny values). The costs must return a finite, non-negative value with a finite gradient or a
-//! typed error that matches the input; the exact checker must answer or refuse, never panic.
+//! typed error that matches the input; a row's `CostMemo`, told which waypoint moved, must give
+//! the bits of a fresh evaluation; the exact checker must answer or refuse, never panic.
 #![no_main]
 
 use edmp_core::Error;
 use edmp_core::checker::{CheckConfig, check_state, check_trajectory};
-use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
+use edmp_core::cost::{CostConfig, CostKind, CostMemo, trajectory_cost, trajectory_cost_memo};
 use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
 use edmp_core::scene::{Obstacle, Scene, SceneError};
 use libfuzzer_sys::fuzz_target;
@@ -91,6 +92,28 @@ fuzz_target!(|data: &[u8]| {
         Err(Error::NonFiniteJoint { .. }) => assert!(params_ok && !joints_finite),
         Err(Error::Overflow) | Err(Error::NonFiniteGradient) => assert!(params_ok && joints_finite),
         Err(e) => panic!("unexpected cost error {e:?}"),
+    }
+
+    // The memo: evaluate, move one waypoint by the input's amount, report it, evaluate again.
+    let mut memo = CostMemo::NONE;
+    let first = trajectory_cost_memo(&scene, &trajectory, &config, Some(&mut gradient), Some(&mut memo));
+    let (w, j, by) = (usize::from(r.byte()) % H, usize::from(r.byte()) % 7, r.f32());
+    let mut moved = trajectory;
+    moved[w][j] += by;
+    if moved[w][j].to_bits() != trajectory[w][j].to_bits() {
+        memo.moved(1 << w);
+    }
+    let mut fresh = [[0.0f32; 7]; H];
+    let mut memoed = [[0.0f32; 7]; H];
+    let want = trajectory_cost(&scene, &moved, &config, Some(&mut fresh));
+    let got = trajectory_cost_memo(&scene, &moved, &config, Some(&mut memoed), Some(&mut memo));
+    if first.is_ok() {
+        let bits = |x: Result<f32, Error>| x.map(f32::to_bits);
+        assert_eq!(bits(got), bits(want), "memo after moving waypoint {w}");
+        if want.is_ok() {
+            let g = |x: &[[f32; 7]; H]| x.map(|q| q.map(f32::to_bits));
+            assert_eq!(g(&memoed), g(&fresh), "memo gradient after moving waypoint {w}");
+        }
     }
 
     let check = CheckConfig { self_collision: flags & 8 == 0, ..CheckConfig::default() };

@@ -444,10 +444,24 @@ fn forward<const C: usize>(
 /// Above 20 it is x (PyTorch's softplus threshold), so `u²` never overflows.
 #[inline]
 fn mish(x: f32) -> f32 {
-    mish_from_exp(x, libm::expf(x.min(20.0)))
+    mish_from_exp(x, mish_exp(x))
 }
 
-/// Mish of `x` given `u = expf(min(x, 20))`.
+/// `e^min(x, 20)` as `expf(min(x, 20) / 8)⁸` (three squarings). `libm::expf` takes one of three
+/// paths by `|x|` (up to ½ ln 2, up to 1.5 ln 2, beyond); on normalized activations the three
+/// are about equally likely and most calls mispredicted the branch (`perf`: `expf` was a quarter
+/// of the network's time). An eighth of the argument stays on the first path except beyond
+/// |x| > 2.77. Relative error 1.8 × 10⁻⁶ instead of 2.1 × 10⁻⁷ on [−20, 20] (numpy, every f32
+/// step of 2 × 10⁻⁵), far below the int8 weights' error; the same bits on every target.
+#[inline(always)]
+fn mish_exp(x: f32) -> f32 {
+    let e = libm::expf(x.min(20.0) * 0.125);
+    let e2 = e * e;
+    let e4 = e2 * e2;
+    e4 * e4
+}
+
+/// Mish of `x` given `u = mish_exp(x)`.
 #[inline(always)]
 fn mish_from_exp(x: f32, u: f32) -> f32 {
     let n = u * (u + 2.0);
@@ -766,7 +780,7 @@ fn norm_mish(x: &mut [f32], channels: usize, lay: Layout, gamma: &[f32], beta: &
                 };
                 for (v, e) in run.iter_mut().zip(&mut u) {
                     *v = (*v - mean) * ga + be;
-                    *e = libm::expf(v.min(20.0));
+                    *e = mish_exp(*v);
                 }
                 for (v, e) in run.iter_mut().zip(&u) {
                     *v = mish_from_exp(*v, *e);
