@@ -1,13 +1,19 @@
 //! Costs and the exact checker (issue targets on one core: cost + gradient for 12 × 50
 //! waypoints in a 20-obstacle scene ≤ 1 ms; exact check of one 50-waypoint trajectory with
-//! interpolation ≤ 0.5 ms). Run: `cargo bench -p edmp-core --bench collision`.
+//! interpolation ≤ 0.5 ms), and guidance steps with and without the costs' memos (the same
+//! bits; the ratio is the memo's worth). Run: `cargo bench -p edmp-core --bench collision`.
 
 use core::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use edmp_core::checker::{CheckConfig, check_trajectory};
-use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
+use edmp_core::cost::{CostConfig, CostKind, CostMemo, trajectory_cost};
+use edmp_core::executor::Serial;
 use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
+use edmp_core::guidance::{StepRule, guide_step_on};
+use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::kinematics::forward;
 use edmp_core::rng::Rng;
+use edmp_core::robot::HAND_FRAME;
 use edmp_core::scene::{Obstacle, Scene};
 
 const H: usize = 50;
@@ -95,6 +101,61 @@ fn bench(c: &mut Criterion) {
                 sum
             })
         });
+    }
+    // The planner's gradient steps at one t (4 after a denoising step at t = 100, a 24-step
+    // stretch of the refinement at t = 1), with and without a memo per row: the same rows
+    // (asserted), less work where a row touches an obstacle along a few of its segments and not
+    // the others. "one cube": every row is the first arc, whose hand passes through a 12 cm cube
+    // at its middle waypoint (as after denoising, when most of a candidate is free); in the
+    // 20-obstacle scene above most segments of most rows touch something.
+    let mut cube = Scene::<64>::new();
+    let hand = forward(&batch[0][H / 2]).unwrap().frames[HAND_FRAME].translation;
+    cube.push(Obstacle::cuboid(hand.into(), [0.12; 3], [1.0, 0.0, 0.0, 0.0]).unwrap())
+        .unwrap();
+    let first = [batch[0]; BATCH];
+    let rule = StepRule {
+        step_limit: 0.1,
+        cylinder: CylinderBox::Enclosing,
+        frame: BoxFrame::Obstacle,
+    };
+    let count = |t: u16| if t == 1 { 24 } else { 4 };
+    let steps = |scene: &Scene<64>, rows: &[[[f32; 7]; H]; BATCH], t: u16, with_memos: bool| {
+        let mut rows = *rows;
+        let mut grads = [[[0.0f32; 7]; H]; BATCH];
+        let mut settled = [false; BATCH];
+        let mut memos = [CostMemo::NONE; BATCH];
+        let memos = if with_memos { &mut memos[..] } else { &mut [][..] };
+        for _ in 0..count(t) {
+            guide_step_on(
+                &Serial,
+                scene,
+                &mut rows,
+                &mut grads,
+                &EDMP_GUIDES,
+                t,
+                &rule,
+                &mut settled,
+                memos,
+            )
+            .unwrap();
+        }
+        rows
+    };
+    for (scene_name, scene, rows) in [("one cube", &cube, &first), ("20 obstacles", &scene, &batch)] {
+        for t in [1, 100] {
+            assert!(
+                steps(scene, rows, t, true) == steps(scene, rows, t, false),
+                "the memos changed the rows at t = {t}, {scene_name}"
+            );
+            for with_memos in [false, true] {
+                let name = format!(
+                    "{} guidance steps of the 12 guides, {scene_name}, t = {t}, {}",
+                    count(t),
+                    if with_memos { "with memos" } else { "without" }
+                );
+                group.bench_function(name, |b| b.iter(|| steps(scene, rows, black_box(t), with_memos)));
+            }
+        }
     }
     let report = check_trajectory(&scene, &batch[0], &CheckConfig::default(), false).unwrap();
     assert!(report.is_free());
