@@ -321,8 +321,9 @@ impl Pulls {
 /// A unit that reached nothing and none of whose waypoints moved a bit reaches nothing again:
 /// [`trajectory_cost_memo`] skips it, and its waypoints' FK when no other unit needs them. The
 /// result is the same bits as a full evaluation (such a unit adds no volume and no pull).
-/// Between the guidance steps at one `t` most waypoints do not move (a zero gradient moves
-/// nothing), so most of a row's segments are skipped.
+/// Between the guidance steps at one `t` a waypoint with a zero gradient does not move, so in
+/// a cluttered scene many of a row's segments that pass near obstacles without touching them
+/// are skipped (docs/benchmark.md, sixth session, for what that is worth where).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CostMemo {
     /// The configuration of the last evaluation; `None`: nothing is known (every unit runs).
@@ -433,10 +434,12 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
     let swept_kind = config.kind == CostKind::Swept;
     // Unit `u` of waypoint `w`'s units: sv segments `w − 1` and `w`; iv waypoint `w` itself.
     let runs = |u: usize| -> bool {
+        // A unit beyond bit 63 has no memo bits (and a memo only holds for H ≤ 64).
+        let span = |bits: u64| bits.checked_shl(u as u32).unwrap_or(0);
         if swept_kind {
-            u + 1 < H && !known.skips(u, 0b11 << u)
+            u + 1 < H && !known.skips(u, span(0b11))
         } else {
-            u > 0 && u + 1 < H && !known.skips(u, 1 << u)
+            u > 0 && u + 1 < H && !known.skips(u, span(1))
         }
     };
     let needed = |w: usize| -> bool {
@@ -880,6 +883,25 @@ mod tests {
                 memo.moved(moved);
             }
             assert!(skipped_some, "{kind:?}: the memo never had a quiet unit to skip");
+        }
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "trajectory costs: too slow")]
+    fn a_trajectory_longer_than_the_memo_is_costed_in_full() {
+        let mut scene = Scene::<1>::new();
+        scene
+            .push(Obstacle::cuboid([0.5, 0.0, 0.4], [0.05, 0.3, 0.05], ID).unwrap())
+            .unwrap();
+        let traj: [Joints<f32>; 70] = sweep();
+        for kind in [CostKind::Intersection, CostKind::Swept] {
+            let c = config(kind);
+            let mut memo = CostMemo::NONE;
+            let want = trajectory_cost(&scene, &traj, &c, None).unwrap();
+            for _ in 0..2 {
+                let got = trajectory_cost_memo(&scene, &traj, &c, None, Some(&mut memo)).unwrap();
+                assert_eq!(got.to_bits(), want.to_bits(), "{kind:?}");
+            }
         }
     }
 
