@@ -432,23 +432,15 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
         _ => CostMemo::NONE,
     };
     let swept_kind = config.kind == CostKind::Swept;
-    // Unit `u` of waypoint `w`'s units: sv segments `w − 1` and `w`; iv waypoint `w` itself.
+    // The units: sv segment `u` joins waypoints `u` and `u + 1`; iv unit `u` is interior waypoint `u`.
+    let is_unit = |u: usize| u + 1 < H && (swept_kind || u > 0);
     let runs = |u: usize| -> bool {
         // A unit beyond bit 63 has no memo bits (and a memo only holds for H ≤ 64).
-        let span = |bits: u64| bits.checked_shl(u as u32).unwrap_or(0);
-        if swept_kind {
-            u + 1 < H && !known.skips(u, span(0b11))
-        } else {
-            u > 0 && u + 1 < H && !known.skips(u, span(1))
-        }
+        let span = if swept_kind { 0b11u64 } else { 1 }.checked_shl(u as u32).unwrap_or(0);
+        is_unit(u) && !known.skips(u, span)
     };
-    let needed = |w: usize| -> bool {
-        if swept_kind {
-            (w > 0 && runs(w - 1)) || runs(w)
-        } else {
-            runs(w)
-        }
-    };
+    // Waypoint `w` is needed by the units that contain it: sv segments `w − 1` and `w`.
+    let needed = |w: usize| runs(w) || (swept_kind && w > 0 && runs(w - 1));
     let mut quiet = 0u64;
 
     let mut gradient = gradient;
@@ -458,19 +450,19 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
     let mut pair = [Waypoint::EMPTY; 2];
     let [before, current] = &mut pair;
     let (mut before, mut current) = (before, current);
-    let (mut before_placed, mut current_placed);
-    before_placed = false;
+    let mut before_placed = false;
     for (w, q) in trajectory.iter().enumerate() {
-        current_placed = needed(w);
-        if current_placed {
+        let placed = needed(w);
+        if placed {
             // The scene's finger opening places the finger boxes; for the adjoint it is a constant.
             forward_into(q, scene.gripper(), &mut current.k)?;
             current.place(held, &radii);
         }
         // The unit that ends at this waypoint: sv the segment into it, iv the waypoint itself.
         let unit = if swept_kind { w.checked_sub(1) } else { Some(w) };
-        if let Some(u) = unit.filter(|&u| u < H.saturating_sub(1) && (swept_kind || u > 0)) {
-            let hit = if runs(u) {
+        if let Some(u) = unit.filter(|&u| is_unit(u)) {
+            // A unit not run was quiet and nothing of it moved: it is quiet still.
+            let hit = runs(u) && {
                 let (v, hit) = if swept_kind {
                     swept(before, current, obstacles)
                 } else {
@@ -478,9 +470,6 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
                 };
                 total += v;
                 hit
-            } else {
-                // Skipped: it was quiet and nothing of it moved.
-                false
             };
             if !hit && u < 64 {
                 quiet |= 1 << u;
@@ -490,7 +479,7 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
             finish(before, before_placed, w - 1, gradient.as_deref_mut())?;
         }
         core::mem::swap(&mut before, &mut current);
-        before_placed = current_placed;
+        before_placed = placed;
     }
     if H > 0 {
         finish(before, before_placed, H - 1, gradient)?;
@@ -886,13 +875,19 @@ mod tests {
         }
     }
 
-    #[test]
-    #[cfg_attr(miri, ignore = "trajectory costs: too slow")]
-    fn a_trajectory_longer_than_the_memo_is_costed_in_full() {
+    /// One bar across the sweep's path.
+    fn bar() -> Scene<1> {
         let mut scene = Scene::<1>::new();
         scene
             .push(Obstacle::cuboid([0.5, 0.0, 0.4], [0.05, 0.3, 0.05], ID).unwrap())
             .unwrap();
+        scene
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "trajectory costs: too slow")]
+    fn a_trajectory_longer_than_the_memo_is_costed_in_full() {
+        let scene = bar();
         let traj: [Joints<f32>; 70] = sweep();
         for kind in [CostKind::Intersection, CostKind::Swept] {
             let c = config(kind);
@@ -908,10 +903,7 @@ mod tests {
     #[test]
     #[cfg_attr(miri, ignore = "trajectory costs: too slow")]
     fn a_forgotten_memo_runs_everything() {
-        let mut scene = Scene::<1>::new();
-        scene
-            .push(Obstacle::cuboid([0.5, 0.0, 0.4], [0.05, 0.3, 0.05], ID).unwrap())
-            .unwrap();
+        let scene = bar();
         let c = config(CostKind::Swept);
         let mut traj: [Joints<f32>; 8] = sweep();
         let mut memo = CostMemo::NONE;
