@@ -4,7 +4,11 @@ N problems of every family of both committed suites and compares the plans field
 the times (`timing_ms`) left out. For changes that must not change a plan (a faster kernel, a
 cheaper broad phase): a difference names the problem and the first field that differs.
 
-    python3 benchmarks/same_bits.py OLD_BINARY NEW_BINARY [--per-family 25] [--jobs 2] [-- extra plan args]
+    python3 benchmarks/same_bits.py OLD_BINARY NEW_BINARY [--per-family 25] [--jobs 2] [--winner-only] \
+        [-- extra plan args]
+
+`--winner-only` plans without `--candidates`, as a user does: the chosen plan alone, which the
+planner judges only as many candidates for as the winner needs (`Judging::Winner`).
 
 Exit 0 when every plan is identical, 1 otherwise. Standard library only.
 """
@@ -19,8 +23,9 @@ from pathlib import Path
 SUITES = ["benchmarks/problems", "benchmarks/unseen"]
 
 
-def plan(binary: str, problem: Path, extra: list[str]) -> dict:
-    out = subprocess.run([binary, "plan", str(problem), "--candidates", *extra], capture_output=True, text=True)
+def plan(binary: str, problem: Path, extra: list[str], candidates: bool = True) -> dict:
+    flags = ["--candidates"] if candidates else []
+    out = subprocess.run([binary, "plan", str(problem), *flags, *extra], capture_output=True, text=True)
     try:
         doc = json.loads(out.stdout)
     except json.JSONDecodeError:
@@ -58,6 +63,7 @@ def main() -> int:
     ap.add_argument("new")
     ap.add_argument("--per-family", type=int, default=25)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--winner-only", action="store_true", help="plan without --candidates")
     ap.add_argument("extra", nargs="*", help="extra `plan` arguments (after --)")
     args = ap.parse_args()
     problems = [
@@ -69,7 +75,8 @@ def main() -> int:
     ]
 
     def compare(p: Path):
-        return p, first_difference(plan(args.old, p, args.extra), plan(args.new, p, args.extra))
+        every = not args.winner_only
+        return p, first_difference(plan(args.old, p, args.extra, every), plan(args.new, p, args.extra, every))
 
     differ = 0
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:

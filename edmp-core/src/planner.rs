@@ -99,6 +99,25 @@ pub struct PlanConfig {
     /// Step-size control in the refinement ([`StepControl`]: a step that raised a guide's cost
     /// is undone and its step halves; `false`: EDMP's fixed steps). An ablation.
     pub step_control: bool,
+    /// Which candidates the exact checker judges ([`Judging`]).
+    pub judging: Judging,
+}
+
+/// Which candidates the exact checker judges once the guides are done. The winner, its path
+/// and its verdict are the same bits either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Judging {
+    /// Every candidate gets a verdict: the multimodal output with every alternative judged
+    /// (`plan --candidates`, the ensemble studies of docs/benchmark.md).
+    Every,
+    /// Only what the winner needs. [`judge`] takes the candidates in order of swept volume
+    /// (the lowest row on ties) and stops at the first free one, which is the candidate
+    /// [`Judging::Every`] picks; the candidates after it keep `checked: false`. When none is
+    /// free, every candidate is judged. The refinement's early stop likewise checks its rows
+    /// one after the other (`Executor::parts` at a time) and stops at the certificate that
+    /// ends it. A free candidate is checked state by state to the end, so each one skipped
+    /// saves a whole trajectory's check.
+    Winner,
 }
 
 /// When the refinement may end early: the exact checker certifies rows free (judged as
@@ -127,6 +146,10 @@ impl RefineStop {
 pub struct Verdict {
     /// Swept volume of the final trajectory against the uninflated obstacles (m³·segments).
     pub swept: f32,
+    /// Whether the exact checker judged this candidate; `false` only under
+    /// [`Judging::Winner`], for candidates after the winner in order of swept volume (then
+    /// `free` is `false` and `colliding_states` is `u32::MAX`: unknown, never picked).
+    pub checked: bool,
     /// Whether the exact checker found no contact anywhere along the trajectory.
     pub free: bool,
     /// States the exact checker found in contact. Counted in full only when no candidate is
@@ -193,6 +216,7 @@ impl PlanConfig {
         refine_stop: Some(RefineStop::DEFAULT),
         refine_guide: None,
         step_control: false,
+        judging: Judging::Winner,
     };
 }
 
@@ -203,6 +227,7 @@ impl<const B: usize> Plan<B> {
             paths: [[[0.0; JOINTS]; HORIZON]; B],
             verdicts: [Verdict {
                 swept: 0.0,
+                checked: false,
                 free: false,
                 colliding_states: 0,
             }; B],
@@ -234,6 +259,7 @@ impl<const B: usize> Plan<B> {
         }
         for verdict in &self.verdicts {
             eat(verdict.swept.to_bits());
+            eat(u32::from(verdict.checked));
             eat(u32::from(verdict.free));
             eat(verdict.colliding_states);
         }
@@ -525,24 +551,36 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
         if let Some(stop) = config.refine_stop
             && s % stop.every == 0
         {
-            // Each row's check is its own: `exec` may run them at once.
+            // Each row's check is its own: `exec` may run them at once. Under
+            // `Judging::Winner` a group of `exec.parts()` rows at a time, until enough are free.
+            let mut free = certified.iter().filter(|&&c| c).count();
             let mut rows: heapless::Vec<(&Path, &mut bool, &mut Option<u16>), B> = heapless::Vec::new();
             for ((x, done), touched) in paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut()) {
                 if !*done && rows.push((x, done, touched)).is_err() {
                     return Err(Error::BadParameter);
                 }
             }
-            exec.each(&mut rows, |(x, done, touched)| {
-                let mut judged = **x;
-                clamp_for_judging(&mut judged, start, goal);
-                let from = touched.map_or(0, usize::from);
-                let report = check_trajectory_from(scene, &judged, &config.check, from)?;
-                **done = report.is_free();
-                **touched = report.first_contact.map(|c| c.segment);
-                Ok(())
-            })?;
+            let group = match config.judging {
+                Judging::Every => B,
+                Judging::Winner => exec.parts(),
+            };
+            for group in rows.chunks_mut(group.max(1)) {
+                if free >= usize::from(stop.free) {
+                    break;
+                }
+                exec.each(group, |(x, done, touched)| {
+                    let mut judged = **x;
+                    clamp_for_judging(&mut judged, start, goal);
+                    let from = touched.map_or(0, usize::from);
+                    let report = check_trajectory_from(scene, &judged, &config.check, from)?;
+                    **done = report.is_free();
+                    **touched = report.first_contact.map(|c| c.segment);
+                    Ok(())
+                })?;
+                free += group.iter().filter(|(_, done, _)| **done).count();
+            }
             drop(rows);
-            if certified.iter().filter(|&&c| c).count() >= usize::from(stop.free) {
+            if free >= usize::from(stop.free) {
                 return Ok(());
             }
             // A guide stops once all its rows are certified; a certified row whose guide goes on
@@ -704,9 +742,38 @@ pub fn judge<const B: usize, const N: usize>(
         cylinder: config.cylinder,
         frame: config.frame,
     };
-    let known = checks.free.iter().zip(&checks.touched);
-    for ((x, verdict), (&known_free, touched)) in paths.iter_mut().zip(verdicts.iter_mut()).zip(known) {
+    for (x, verdict) in paths.iter_mut().zip(verdicts.iter_mut()) {
         clamp_for_judging(x, start, goal);
+        *verdict = Verdict {
+            swept: trajectory_cost(scene, x, &swept, None)?,
+            checked: false,
+            free: false,
+            colliding_states: u32::MAX,
+        };
+    }
+    // Under `Judging::Winner`, the order `pick` ranks free candidates in: swept volume, then
+    // row (a selection, not a library sort: no panic path for the firmware).
+    let mut judged = [false; B];
+    for _ in 0..B {
+        let next = match config.judging {
+            Judging::Every => judged.iter().position(|&j| !j),
+            Judging::Winner => (0..B).filter(|&r| judged.get(r) == Some(&false)).min_by(|&a, &b| {
+                let swept = |r: usize| verdicts.get(r).map_or(f32::INFINITY, |v| v.swept);
+                swept(a).total_cmp(&swept(b)).then(a.cmp(&b))
+            }),
+        };
+        let Some(r) = next else { break };
+        if let Some(j) = judged.get_mut(r) {
+            *j = true;
+        }
+        let (Some(x), Some(verdict), Some(&known_free), Some(touched)) = (
+            paths.get(r),
+            verdicts.get_mut(r),
+            checks.free.get(r),
+            checks.touched.get(r),
+        ) else {
+            continue;
+        };
         // A certified row was checked in this very form (clamped, ends exact) and not moved.
         let colliding_states = if known_free {
             0
@@ -714,11 +781,12 @@ pub fn judge<const B: usize, const N: usize>(
             let from = touched.map_or(0, usize::from);
             check_trajectory_from(scene, x, &config.check, from)?.colliding_states
         };
-        *verdict = Verdict {
-            swept: trajectory_cost(scene, x, &swept, None)?,
-            free: colliding_states == 0,
-            colliding_states,
-        };
+        verdict.checked = true;
+        verdict.free = colliding_states == 0;
+        verdict.colliding_states = colliding_states;
+        if verdict.free && config.judging == Judging::Winner {
+            break;
+        }
     }
     plan.best = pick(&plan.verdicts);
     plan.stage = if plan.is_free() { Stage::Diffusion } else { Stage::None };
@@ -796,6 +864,7 @@ mod tests {
             refine_stop: None,
             refine_guide: None,
             step_control: false,
+            judging: Judging::Every,
         }
     }
 
@@ -981,6 +1050,82 @@ mod tests {
             assert_eq!(judged.best, plain.best);
         }
         assert!(plain.verdicts[..6].iter().all(|v| !v.free) && plain.verdicts[6..].iter().all(|v| v.free));
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the exact checker over a batch: too slow under Miri")]
+    fn judging_the_winner_only_picks_what_judging_every_candidate_picks() {
+        let scene = wall_scene();
+        let every = PlanConfig {
+            global: None,
+            ..config()
+        };
+        let winner = PlanConfig {
+            judging: Judging::Winner,
+            ..every
+        };
+        // Rows 0-5 collide, 6-11 are free: the lowest swept volume among the free ones wins.
+        let all = select(&scene, &START, &GOAL, &every, mixed_batch(), &RowChecks::NONE).unwrap();
+        let lazy = select(&scene, &START, &GOAL, &winner, mixed_batch(), &RowChecks::NONE).unwrap();
+        assert!(all.verdicts.iter().all(|v| v.checked));
+        assert_eq!(
+            (lazy.best, lazy.verdicts[lazy.best]),
+            (all.best, all.verdicts[all.best])
+        );
+        assert_eq!(lazy.paths, all.paths);
+        let best_swept = all.verdicts[all.best].swept;
+        for (l, a) in lazy.verdicts.iter().zip(&all.verdicts) {
+            assert_eq!(l.swept, a.swept);
+            if l.checked {
+                assert_eq!(l, a);
+                assert!(!l.free || l.swept == best_swept);
+            } else {
+                // Skipped: after the winner in the judging order, and never picked.
+                assert!(l.swept >= best_swept && !l.free && l.colliding_states == u32::MAX);
+            }
+        }
+        assert!(
+            lazy.verdicts.iter().filter(|v| v.checked).count() < 12,
+            "some check was saved"
+        );
+        // Nothing free: every candidate is judged, as under `Judging::Every`.
+        let colliding: [Path; 12] = core::array::from_fn(|_| mixed_batch()[0]);
+        let a = select(&scene, &START, &GOAL, &every, colliding, &RowChecks::NONE).unwrap();
+        let b = select(&scene, &START, &GOAL, &winner, colliding, &RowChecks::NONE).unwrap();
+        assert_eq!(a, b);
+        // The refinement's stop checks rows in order up to the first free one; the paths are
+        // the same as when it checks them all.
+        let refined = |cfg: &PlanConfig| {
+            let mut paths = mixed_batch();
+            let mut grads = [[[0.0; JOINTS]; HORIZON]; 12];
+            let mut saved = grads;
+            let mut checks = RowChecks::NONE;
+            let cfg = PlanConfig {
+                refine_stop: Some(RefineStop { every: 8, free: 1 }),
+                ..*cfg
+            };
+            refine(
+                &Serial,
+                &scene,
+                &START,
+                &GOAL,
+                &mut paths,
+                &mut grads,
+                &mut saved,
+                &EDMP_GUIDES,
+                16,
+                &cfg,
+                &mut checks,
+            )
+            .unwrap();
+            (paths, checks.free)
+        };
+        let (paths_all, certified_all) = refined(&every);
+        let (paths_lazy, certified_lazy) = refined(&winner);
+        assert_eq!(paths_all, paths_lazy);
+        assert_eq!(certified_all[..], [[false; 6], [true; 6]].concat()[..]);
+        let first_free: [bool; 12] = core::array::from_fn(|r| r == 6);
+        assert_eq!(certified_lazy, first_free);
     }
 
     #[test]

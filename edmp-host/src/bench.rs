@@ -68,8 +68,9 @@ pub struct Args {
 pub struct Candidate {
     /// The guide it followed (the original's number).
     pub guide: u8,
-    /// Passed the project's exact checker.
-    pub free: bool,
+    /// Passed the project's exact checker; `None`: not judged (the planner judges only as
+    /// many candidates as the winner needs unless `--judge-every`).
+    pub free: Option<bool>,
     /// Swept volume against the uninflated obstacles.
     pub swept: f32,
 }
@@ -163,7 +164,7 @@ fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
         .enumerate()
         .map(|(row, v)| Candidate {
             guide: guides[row / per_guide].id,
-            free: v.free,
+            free: v.checked.then_some(v.free),
             swept: v.swept,
         })
         .collect();

@@ -229,7 +229,7 @@ pub fn run(args: &Args) -> Result<(), String> {
                 let n = e
                     .records
                     .iter()
-                    .filter(|r| r.candidates.iter().any(|c| c.guide == *g && c.free))
+                    .filter(|r| r.candidates.iter().any(|c| c.guide == *g && c.free == Some(true)))
                     .count();
                 100.0 * n as f64 / e.records.len().max(1) as f64
             })

@@ -13,7 +13,7 @@ use edmp_core::geometry::{BoxFrame, Inflation};
 use edmp_core::global::GlobalConfig;
 use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide, Schedule};
 use edmp_core::planner::{
-    DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Plan,
+    DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Judging, Plan,
     PlanConfig, RefineStop, Workspace, denoise_on, finish_on, polish, select,
 };
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
@@ -111,6 +111,11 @@ pub struct Tuning {
     /// its step halves (default: EDMP's fixed steps). An ablation.
     #[arg(long)]
     step_control: bool,
+    /// Judge every candidate with the exact checker, not only as many as the winner needs (in
+    /// order of swept volume up to the first free one): the same plan, with a verdict on every
+    /// alternative. `plan --candidates` always does.
+    #[arg(long)]
+    judge_every: bool,
     /// Refine every row with the exact-clearance guide (the checker's hulls against the true
     /// obstacles, within this clearance in metres; 0.03 when given without a value) instead of
     /// its own guide. An ablation.
@@ -197,6 +202,11 @@ impl Tuning {
                 ..CLEARANCE_GUIDE
             }),
             step_control: self.step_control,
+            judging: if self.judge_every {
+                Judging::Every
+            } else {
+                Judging::Winner
+            },
             ..PlanConfig::DEFAULT
         };
         if self.step_limit.is_nan() || self.step_limit <= 0.0 {
@@ -525,7 +535,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let guides = args.tuning.guides(&args.guides)?;
-    let config = args.tuning.config()?;
+    let mut config = args.tuning.config()?;
+    if args.candidates {
+        // Every alternative written gets its verdict.
+        config.judging = Judging::Every;
+    }
     let timed = args.timed.request()?;
 
     let planned = plan_problem_on(&problem, &guides, &config, args.seed, args.tuning.threads()?)?;

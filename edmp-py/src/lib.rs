@@ -6,7 +6,7 @@
 //! from Python is the CLI's document. Planning releases the GIL.
 
 use edmp_core::checker::{CheckConfig, Contact, check_trajectory};
-use edmp_core::planner::PlanConfig;
+use edmp_core::planner::{Judging, PlanConfig};
 use edmp_core::prior::HORIZON;
 use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS};
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
@@ -91,7 +91,11 @@ fn plan(
     let doc = py.detach(move || -> Result<Value, Failure> {
         let began = Instant::now();
         let guides = chosen_guides(&[])?;
-        let config = PlanConfig::DEFAULT;
+        let config = PlanConfig {
+            // Every alternative returned gets its verdict.
+            judging: if candidates { Judging::Every } else { Judging::Winner },
+            ..PlanConfig::DEFAULT
+        };
         let planned = plan_problem(&problem, &guides, &config, seed)?;
         let total_ms = began.elapsed().as_secs_f64() * 1e3;
         let mut doc = plan_document(&problem, &planned, &guides, &config, seed, candidates, total_ms)?;
