@@ -14,8 +14,9 @@
 
 use crate::convex::{Hull, Primitive};
 use crate::error::Error;
-use crate::gjk::{apart, distance_lower_bound};
+use crate::gjk::{apart_by, distance_lower_bound};
 use crate::kinematics::{Joints, Kinematics, forward_with};
+use crate::reach::{BODY_REACH, HAND_REACH, motion};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Scene, Shape};
 use nalgebra::{Matrix3, Vector3};
@@ -193,25 +194,29 @@ impl Placed<'_> {
         }
     }
 
-    /// Body `b` (robot or held) proven apart from primitive `p`.
-    fn body_apart_from(&self, b: usize, p: &Primitive, hint: &mut Vector3<f32>) -> bool {
+    /// Body `b` (robot or held) proven apart from primitive `p`: the certified gap (above the
+    /// margin), `None` when it is not proven.
+    fn body_apart_from(&self, b: usize, p: &Primitive, hint: &mut Vector3<f32>) -> Option<f32> {
         if b >= BODIES {
-            return self.held.as_ref().is_none_or(|h| apart(h, p, self.margin, hint));
+            return match &self.held {
+                Some(h) => apart_by(h, p, self.margin, hint),
+                None => Some(f32::INFINITY),
+            };
         }
         // The oriented box holds the hull: proving the box apart is enough, and cheap.
-        apart(&self.obb(b), p, self.margin, hint) || apart(&self.hull(b), p, self.margin, hint)
+        apart_by(&self.obb(b), p, self.margin, hint).or_else(|| apart_by(&self.hull(b), p, self.margin, hint))
     }
 
-    /// Bodies `a < b` proven apart.
-    fn bodies_apart(&self, a: usize, b: usize, hint: &mut Vector3<f32>) -> bool {
+    /// Bodies `a < b` proven apart: the certified gap, as [`Placed::body_apart_from`].
+    fn bodies_apart(&self, a: usize, b: usize, hint: &mut Vector3<f32>) -> Option<f32> {
         let m = self.self_margin;
         if b >= BODIES {
             return match &self.held {
-                Some(h) => apart(&self.obb(a), h, m, hint) || apart(&self.hull(a), h, m, hint),
-                None => true,
+                Some(h) => apart_by(&self.obb(a), h, m, hint).or_else(|| apart_by(&self.hull(a), h, m, hint)),
+                None => Some(f32::INFINITY),
             };
         }
-        apart(&self.obb(a), &self.obb(b), m, hint) || apart(&self.hull(a), &self.hull(b), m, hint)
+        apart_by(&self.obb(a), &self.obb(b), m, hint).or_else(|| apart_by(&self.hull(a), &self.hull(b), m, hint))
     }
 }
 
@@ -247,6 +252,44 @@ fn validate(config: &CheckConfig) -> Result<(), Error> {
 
 const PAIRS: usize = SLOTS * SLOTS;
 
+/// How far two shapes can move relative to each other for joint steps `step`: a joint that
+/// turns both turns them together and changes nothing between them; one that turns only one
+/// moves it by its reach ([`crate::reach`]).
+fn relative_motion(a: &[f32; JOINTS], b: &[f32; JOINTS], step: &Joints<f32>) -> f32 {
+    let mut m = 0.0f32;
+    for ((ra, rb), d) in a.iter().zip(b).zip(step) {
+        if !(*ra > 0.0 && *rb > 0.0) {
+            m += (ra + rb) * d;
+        }
+    }
+    m
+}
+
+/// What a certified gap leaves for the states after it, below the gap less the margin: room for
+/// the kinematics' f32 rounding (metres).
+const CARRY_SLACK: f32 = 1e-4;
+
+/// Clearance carried from one state to the next ([`crate::reach`]): per pair, how far its
+/// shapes may still move, together, before the gap last certified for it no longer proves the
+/// margin. A pair with slack left at a state is free there without a test, and a state all of
+/// whose pairs have slack left needs no kinematics.
+struct Slack<const N: usize> {
+    obstacle: [[f32; N]; SLOTS],
+    body: [[f32; SLOTS]; SLOTS],
+    /// The state the slack was last used up to; `None`: nothing carried yet.
+    at: Option<Joints<f32>>,
+}
+
+impl<const N: usize> Slack<N> {
+    fn new() -> Self {
+        Self {
+            obstacle: [[0.0; N]; SLOTS],
+            body: [[0.0; SLOTS]; SLOTS],
+            at: None,
+        }
+    }
+}
+
 /// What stays the same for every state of one check: the obstacles and their bounding balls,
 /// the robot shapes' ball radii, the self-collision pairs, and the separating directions
 /// remembered so far.
@@ -260,6 +303,9 @@ struct Prepared<'s, const N: usize> {
     pairs: [(u8, u8); PAIRS],
     pair_count: usize,
     hints: Hints<N>,
+    /// Per shape and joint, how far a point of the shape can be from the joint's axis.
+    reach: [[f32; JOINTS]; SLOTS],
+    slack: Slack<N>,
 }
 
 impl<'s, const N: usize> Prepared<'s, N> {
@@ -273,6 +319,14 @@ impl<'s, const N: usize> Prepared<'s, N> {
             (Some(body), _) => libm::sqrtf(body.half_extents.norm_squared()),
             (None, Some(h)) => Primitive::obstacle(h).bounding_radius(),
             (None, None) => 0.0,
+        });
+        // The held object's points lie within |centre| + its ball's radius of the hand's origin.
+        let held_extent = scene.held().map_or(0.0, |h| {
+            (libm::sqrtf(h.center.norm_squared()) + Primitive::obstacle(h).bounding_radius()) * (1.0 + 1e-5)
+        });
+        let reach = core::array::from_fn(|b| match BODY_REACH.get(b) {
+            Some(r) => *r,
+            None => HAND_REACH.map(|r| r + held_extent),
         });
         let mut pairs = [(0u8, 0u8); PAIRS];
         let mut pair_count = 0;
@@ -296,23 +350,63 @@ impl<'s, const N: usize> Prepared<'s, N> {
             pairs,
             pair_count,
             hints: Hints::new(),
+            reach,
+            slack: Slack::new(),
         })
     }
 
     /// The first contact at configuration `q`, if any; `margin` is the obstacle clearance
     /// this state must keep.
+    ///
+    /// A pair whose carried slack ([`Slack`]) outlasts the motion since the last state is free
+    /// here without a test; the others are tested, and a pair proven apart carries its new gap
+    /// less the largest margin a state may need (`margin` or `end_margin`). Every "free" is
+    /// still certified: by a separating direction at this state, or at an earlier one whose
+    /// gap the motion since (bounded by [`crate::reach`]) cannot have used up.
     fn contact_at(&mut self, q: &Joints<f32>, margin: f32) -> Result<Option<Contact>, Error> {
+        let count = self.scene.obstacles().len();
+        let step: Joints<f32> = match &self.slack.at {
+            Some(last) => core::array::from_fn(|j| (q[j] - last[j]).abs()),
+            // Nothing carried: every slack is still 0, so every pair is tested.
+            None => [0.0; JOINTS],
+        };
+        let moved: [f32; SLOTS] = core::array::from_fn(|b| self.reach.get(b).map_or(f32::INFINITY, |r| motion(r, &step)));
+        self.slack.at = Some(*q);
+        // Use up every pair's slack; only pairs left without any are tested.
+        let mut untested = false;
+        for b in (0..self.shapes).filter(|&b| moves(b)) {
+            for s in self.slack.obstacle[b % SLOTS].iter_mut().take(count) {
+                *s -= moved[b % SLOTS];
+                untested |= !(*s > 0.0);
+            }
+        }
+        if self.config.self_collision {
+            for &(a, b) in self.pairs.iter().take(self.pair_count) {
+                let (a, b) = (usize::from(a) % SLOTS, usize::from(b) % SLOTS);
+                let s = &mut self.slack.body[a][b];
+                *s -= relative_motion(&self.reach[a], &self.reach[b], &step);
+                untested |= !(*s > 0.0);
+            }
+        }
+        if !untested {
+            return Ok(None);
+        }
         let k = forward_with(q, self.scene.gripper())?;
         let self_margin = self.config.self_margin;
+        let carry = self.config.margin.max(self.config.end_margin) + CARRY_SLACK;
+        let carry_self = self_margin + CARRY_SLACK;
         let held = self.scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME]));
         let center: [Vector3<f32>; SLOTS] = core::array::from_fn(|b| match (k.boxes.get(b), &held) {
             (Some(pose), _) => pose.translation,
             (None, Some(h)) => h.center,
             (None, None) => Vector3::zeros(),
         });
-        let near = |c1: &Vector3<f32>, r1: f32, c2: &Vector3<f32>, r2: f32, margin: f32| {
+        // The balls' gap when they are apart by more than `margin`: a lower bound on the
+        // distance between the shapes they hold.
+        let ball_gap = |c1: &Vector3<f32>, r1: f32, c2: &Vector3<f32>, r2: f32, margin: f32| {
+            let d2 = (c1 - c2).norm_squared();
             let reach = r1 + r2 + margin;
-            (c1 - c2).norm_squared() <= reach * reach
+            (d2 > reach * reach).then(|| libm::sqrtf(d2) - r1 - r2)
         };
         let placed = Placed {
             k: &k,
@@ -320,22 +414,30 @@ impl<'s, const N: usize> Prepared<'s, N> {
             margin,
             self_margin,
         };
-        let count = self.scene.obstacles().len();
         for b in (0..self.shapes).filter(|&b| moves(b)) {
             let candidates = self
                 .obstacles
                 .iter()
                 .zip(self.obstacle_radius.iter())
-                .zip(self.hints.obstacle[b % SLOTS].iter_mut());
-            for (i, ((o, &r), hint)) in candidates.take(count).enumerate() {
-                if near(&center[b % SLOTS], self.radius[b % SLOTS], &o.center, r, margin)
-                    && !placed.body_apart_from(b, o, hint)
-                {
-                    return Ok(Some(Contact::Obstacle {
-                        body: b as u8,
-                        obstacle: i as u8,
-                    }));
+                .zip(self.hints.obstacle[b % SLOTS].iter_mut())
+                .zip(self.slack.obstacle[b % SLOTS].iter_mut());
+            for (i, (((o, &r), hint), slack)) in candidates.take(count).enumerate() {
+                if *slack > 0.0 {
+                    continue;
                 }
+                let gap = match ball_gap(&center[b % SLOTS], self.radius[b % SLOTS], &o.center, r, margin) {
+                    Some(gap) => gap,
+                    None => match placed.body_apart_from(b, o, hint) {
+                        Some(gap) => gap,
+                        None => {
+                            return Ok(Some(Contact::Obstacle {
+                                body: b as u8,
+                                obstacle: i as u8,
+                            }));
+                        }
+                    },
+                };
+                *slack = gap - carry;
             }
         }
         if !self.config.self_collision {
@@ -344,14 +446,24 @@ impl<'s, const N: usize> Prepared<'s, N> {
         for &(a, b) in self.pairs.iter().take(self.pair_count) {
             // `% SLOTS`: pairs hold shape indices below SLOTS; the modulo proves it to the compiler.
             let (a, b) = (usize::from(a) % SLOTS, usize::from(b) % SLOTS);
-            if near(&center[a], self.radius[a], &center[b], self.radius[b], self_margin)
-                && !placed.bodies_apart(a, b, &mut self.hints.body[a][b])
-            {
-                return Ok(Some(Contact::SelfContact {
-                    first: a as u8,
-                    second: b as u8,
-                }));
+            let slack = &mut self.slack.body[a][b];
+            if *slack > 0.0 {
+                continue;
             }
+            let gap = match ball_gap(&center[a], self.radius[a], &center[b], self.radius[b], self_margin) {
+                Some(gap) => gap,
+                None => match placed.bodies_apart(a, b, &mut self.hints.body[a][b]) {
+                    Some(gap) => gap,
+                    None => {
+                        return Ok(Some(Contact::SelfContact {
+                            first: a as u8,
+                            second: b as u8,
+                        }));
+                    }
+                },
+            };
+            *slack = gap - carry_self;
+
         }
         Ok(None)
     }
@@ -666,6 +778,64 @@ mod tests {
             .push(Obstacle::cuboid([0.0, 0.0, -0.01], [0.3, 0.3, 0.02], ID).unwrap())
             .unwrap();
         assert_eq!(check_state(&scene, &READY, &CheckConfig::default()), Ok(None));
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the exact checker at many states: hours under Miri")]
+    fn carried_clearance_gives_the_verdicts_of_testing_every_state_afresh() {
+        // A cluttered scene, an object in the hand, and random walks through it: a trajectory
+        // check carries clearance from state to state, `check_state` tests each one alone.
+        let mut scene = Scene::<8>::new();
+        for (center, dims) in [
+            ([0.55, 0.0, 0.35], [0.3, 0.02, 0.5]),
+            ([0.4, 0.35, 0.2], [0.1, 0.1, 0.4]),
+            ([0.35, -0.4, 0.5], [0.2, 0.05, 0.05]),
+            ([0.5, 0.0, -0.02], [1.2, 1.2, 0.02]),
+        ] {
+            scene.push(Obstacle::cuboid(center, dims, ID).unwrap()).unwrap();
+        }
+        scene.hold(Obstacle::cuboid([0.0, 0.0, 0.15], [0.04, 0.04, 0.08], ID).unwrap());
+        // Margins the same at the ends and elsewhere, so that `check_state` is the reference.
+        let cfg = CheckConfig {
+            end_margin: DEFAULT_MARGIN,
+            ..CheckConfig::default()
+        };
+        let mut seed = 11u64;
+        let mut uniform = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut states, mut colliding, mut free_walks) = (0, 0, 0);
+        for _ in 0..24 {
+            let mut q: Joints<f32> =
+                core::array::from_fn(|j| PANDA.soft_lower[j] + uniform() * (PANDA.soft_upper[j] - PANDA.soft_lower[j]));
+            let walk: [Joints<f32>; 6] = core::array::from_fn(|_| {
+                q = core::array::from_fn(|j| {
+                    (q[j] + 0.6 * (2.0 * uniform() - 1.0)).clamp(PANDA.soft_lower[j], PANDA.soft_upper[j])
+                });
+                q
+            });
+            let carried = check_trajectory(&scene, &walk, &cfg, false).unwrap();
+            let mut afresh = 0;
+            let mut count = 0;
+            for pair in walk.windows(2) {
+                let steps = segment_steps(&pair[0], &pair[1], cfg.max_step).unwrap();
+                for step in 0..steps {
+                    count += 1;
+                    let state = interpolate(&pair[0], &pair[1], step, steps);
+                    afresh += u32::from(check_state(&scene, &state, &cfg).unwrap().is_some());
+                }
+            }
+            count += 1;
+            afresh += u32::from(check_state(&scene, &walk[5], &cfg).unwrap().is_some());
+            assert_eq!(carried.states, count);
+            assert_eq!(carried.colliding_states, afresh, "walk {walk:?}");
+            states += count;
+            colliding += afresh;
+            free_walks += u32::from(afresh == 0);
+        }
+        // The walks are not all in contact, nor all free.
+        assert!(colliding > 0 && colliding < states && free_walks > 0, "{colliding} of {states}, {free_walks} free");
     }
 
     #[test]

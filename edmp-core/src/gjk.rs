@@ -88,34 +88,43 @@ pub fn gap_along<A: Convex, B: Convex>(a: &A, b: &B, n: &V) -> f32 {
 /// direction, and checking it costs two support evaluations instead of a GJK run. It is
 /// updated with the direction GJK finds.
 pub fn apart<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> bool {
+    apart_by(a, b, margin, hint).is_some()
+}
+
+/// [`apart`], with the certified gap when it holds: an exact lower bound on the distance,
+/// above `margin`.
+pub fn apart_by<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> Option<f32> {
     let len = libm::sqrtf(hint.norm_squared());
-    if len > 0.0 && gap_along(a, b, &(*hint / len)) > margin {
-        return true;
+    if len > 0.0 {
+        let gap = gap_along(a, b, &(*hint / len));
+        if gap > margin {
+            return Some(gap);
+        }
     }
     let mut start = *hint;
     for _ in 0..RESTARTS {
-        let Some(v) = closest(a, b, &start) else {
-            return false;
-        };
+        let v = closest(a, b, &start)?;
         let len = libm::sqrtf(v.norm_squared());
         if !(len > 0.0 && len.is_finite()) {
-            return false;
+            return None;
         }
         *hint = v;
-        if gap_along(a, b, &(v / len)) > margin {
-            return true;
+        let gap = gap_along(a, b, &(v / len));
+        if gap > margin {
+            return Some(gap);
         }
         // `len` bounds the distance from above: at or below the margin the pair is in reach,
         // and no restart can prove otherwise.
         if len <= margin {
-            return false;
+            return None;
         }
-        if face_gap(a, b, &v) > margin {
-            return true;
+        let gap = face_gap(a, b, &v);
+        if gap > margin {
+            return Some(gap);
         }
         start = v;
     }
-    false
+    None
 }
 
 /// The best exact lower bound along the shapes' face normals, each turned to point from `b`

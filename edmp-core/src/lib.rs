@@ -33,6 +33,7 @@ pub mod ik;
 pub mod kinematics;
 pub mod planner;
 pub mod prior;
+pub mod reach;
 pub mod rng;
 pub mod robot;
 pub mod scene;

@@ -83,6 +83,10 @@ include!(concat!(env!("OUT_DIR"), "/panda.rs"));
 // URDF numbers such as the hardware limit -3.1416 are data, not approximations of π.
 #[allow(clippy::excessive_precision, clippy::approx_constant)]
 pub static PANDA: Robot<f32> = panda_tables!();
+/// The same tables as a constant, for tables derived from them at compile time
+/// ([`crate::reach`]; a `static` cannot be read there).
+#[allow(clippy::excessive_precision, clippy::approx_constant)]
+pub(crate) const PANDA_TABLES: Robot<f32> = panda_tables!();
 /// The Panda in `f64`: for oracles (finite differences) and host-side tools.
 #[allow(clippy::approx_constant)]
 pub static PANDA_F64: Robot<f64> = panda_tables!();
