@@ -370,7 +370,8 @@ impl<'s, const N: usize> Prepared<'s, N> {
             // Nothing carried: every slack is still 0, so every pair is tested.
             None => [0.0; JOINTS],
         };
-        let moved: [f32; SLOTS] = core::array::from_fn(|b| self.reach.get(b).map_or(f32::INFINITY, |r| motion(r, &step)));
+        let moved: [f32; SLOTS] =
+            core::array::from_fn(|b| self.reach.get(b).map_or(f32::INFINITY, |r| motion(r, &step)));
         self.slack.at = Some(*q);
         // Use up every pair's slack; only pairs left without any are tested.
         let mut untested = false;
@@ -463,7 +464,6 @@ impl<'s, const N: usize> Prepared<'s, N> {
                 },
             };
             *slack = gap - carry_self;
-
         }
         Ok(None)
     }
@@ -835,7 +835,10 @@ mod tests {
             free_walks += u32::from(afresh == 0);
         }
         // The walks are not all in contact, nor all free.
-        assert!(colliding > 0 && colliding < states && free_walks > 0, "{colliding} of {states}, {free_walks} free");
+        assert!(
+            colliding > 0 && colliding < states && free_walks > 0,
+            "{colliding} of {states}, {free_walks} free"
+        );
     }
 
     #[test]

@@ -93,7 +93,26 @@ pub fn apart<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> b
 
 /// [`apart`], with the certified gap when it holds: an exact lower bound on the distance,
 /// above `margin`.
+///
+/// A carried direction that fails is tried once more from scratch: GJK started from a stale
+/// direction can stall short of a gap that a fresh start proves, and then whether a state
+/// counts as free would depend on the states checked before it (a search's edge check and the
+/// judge's walk could disagree on the same state).
 pub fn apart_by<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> Option<f32> {
+    let carried = *hint != V::zeros();
+    if let Some(gap) = apart_from(a, b, margin, hint) {
+        return Some(gap);
+    }
+    let mut fresh = V::zeros();
+    if carried && let Some(gap) = apart_from(a, b, margin, &mut fresh) {
+        *hint = fresh;
+        return Some(gap);
+    }
+    None
+}
+
+/// [`apart_by`] from the direction in `hint` only.
+fn apart_from<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> Option<f32> {
     let len = libm::sqrtf(hint.norm_squared());
     if len > 0.0 {
         let gap = gap_along(a, b, &(*hint / len));

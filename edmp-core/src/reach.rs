@@ -12,7 +12,9 @@
 //! rounded up, so every entry bounds the true length from above.
 
 use crate::robot::PANDA_TABLES as TABLES;
-use crate::robot::{BODIES, BodySpec, FINGER_OPENING_MAX, FINGER_OPENING_MIN, FRAMES, FrameSpec, HAND_FRAME, HULL_POINTS, JOINTS};
+use crate::robot::{
+    BODIES, BodySpec, FINGER_OPENING_MAX, FINGER_OPENING_MIN, FRAMES, FrameSpec, HAND_FRAME, HULL_POINTS, JOINTS,
+};
 use nalgebra::Vector3;
 
 /// Per body and joint: how far any point of the body can be from the joint's axis (metres;
@@ -169,6 +171,10 @@ mod tests {
         assert!(BODY_REACH[1][1..].iter().all(|&r| r == 0.0) && BODY_REACH[1][0] > 0.0);
         let hand = 8;
         assert!((0..JOINTS).all(|j| BODY_REACH[hand][j] > 0.0));
-        assert!(BODY_REACH[hand][0] > 0.5 && BODY_REACH[hand][0] < 1.5, "{:?}", BODY_REACH[hand]);
+        assert!(
+            BODY_REACH[hand][0] > 0.5 && BODY_REACH[hand][0] < 1.5,
+            "{:?}",
+            BODY_REACH[hand]
+        );
     }
 }

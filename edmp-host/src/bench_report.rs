@@ -242,6 +242,18 @@ pub fn run(args: &Args) -> Result<(), String> {
         for ((g, w), f) in guides.iter().zip(&won).zip(&free) {
             let _ = writeln!(md, "| {g} | {w:.1} | {f:.1} |");
         }
+        let unjudged = e
+            .records
+            .iter()
+            .filter(|r| r.candidates.iter().any(|c| c.free.is_none()))
+            .count();
+        if unjudged > 0 {
+            let _ = writeln!(
+                md,
+                "\n{unjudged} problems have candidates the planner did not judge (it stops at the winner \
+                 unless `bench --judge-every`): the free column counts them as not free."
+            );
+        }
         let names: Vec<String> = guides.iter().map(u8::to_string).collect();
         plots::grouped_bars(
             &args.out.join("winners.png"),
