@@ -19,6 +19,7 @@ use crate::kinematics::{Joints, Kinematics, forward_with};
 use crate::reach::{BODY_REACH, HAND_REACH, motion};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Scene, Shape};
+use core::cmp::Ordering;
 use nalgebra::{Matrix3, Vector3};
 
 /// Clearance demanded between a robot body and an obstacle away from the ends (metres): the
@@ -378,7 +379,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
         for b in (0..self.shapes).filter(|&b| moves(b)) {
             for s in self.slack.obstacle[b % SLOTS].iter_mut().take(count) {
                 *s -= moved[b % SLOTS];
-                untested |= !(*s > 0.0);
+                untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
             }
         }
         if self.config.self_collision {
@@ -386,7 +387,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
                 let (a, b) = (usize::from(a) % SLOTS, usize::from(b) % SLOTS);
                 let s = &mut self.slack.body[a][b];
                 *s -= relative_motion(&self.reach[a], &self.reach[b], &step);
-                untested |= !(*s > 0.0);
+                untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
             }
         }
         if !untested {

@@ -1019,6 +1019,33 @@ mod tests {
         assert_eq!(a.fingerprint(), run(&cfg).fingerprint());
     }
 
+    /// [`refine`] of [`mixed_batch`] on one thread, starting from `checks`: the refined rows
+    /// and which of them the refinement certified free.
+    fn refine_batch(
+        scene: &Scene<4>,
+        cfg: &PlanConfig,
+        steps: u8,
+        mut checks: RowChecks<12>,
+    ) -> Result<([Path; 12], [bool; 12]), Error> {
+        let mut paths = mixed_batch();
+        let mut grads = [[[0.0; JOINTS]; HORIZON]; 12];
+        let mut saved = grads;
+        refine(
+            &Serial,
+            scene,
+            &START,
+            &GOAL,
+            &mut paths,
+            &mut grads,
+            &mut saved,
+            &EDMP_GUIDES,
+            steps,
+            cfg,
+            &mut checks,
+        )?;
+        Ok((paths, checks.free))
+    }
+
     /// Rows 0-5 on the straight line through the wall, rows 6-11 a detour above it (free).
     fn mixed_batch() -> [Path; 12] {
         let line = |lift: f32| -> Path {
@@ -1096,29 +1123,11 @@ mod tests {
         // The refinement's stop checks rows in order up to the first free one; the paths are
         // the same as when it checks them all.
         let refined = |cfg: &PlanConfig| {
-            let mut paths = mixed_batch();
-            let mut grads = [[[0.0; JOINTS]; HORIZON]; 12];
-            let mut saved = grads;
-            let mut checks = RowChecks::NONE;
             let cfg = PlanConfig {
                 refine_stop: Some(RefineStop { every: 8, free: 1 }),
                 ..*cfg
             };
-            refine(
-                &Serial,
-                &scene,
-                &START,
-                &GOAL,
-                &mut paths,
-                &mut grads,
-                &mut saved,
-                &EDMP_GUIDES,
-                16,
-                &cfg,
-                &mut checks,
-            )
-            .unwrap();
-            (paths, checks.free)
+            refine_batch(&scene, &cfg, 16, RowChecks::NONE).unwrap()
         };
         let (paths_all, certified_all) = refined(&every);
         let (paths_lazy, certified_lazy) = refined(&winner);
@@ -1150,27 +1159,11 @@ mod tests {
                 step_limit: 0.1,
                 ..config()
             };
-            let mut paths = batch;
-            let mut grads = [[[0.0; JOINTS]; HORIZON]; 12];
-            let mut saved = grads;
-            let mut checks = RowChecks {
+            let stale = RowChecks {
                 free: [true; 12],
                 touched: [Some(3); 12],
             };
-            refine(
-                &Serial,
-                &scene,
-                &START,
-                &GOAL,
-                &mut paths,
-                &mut grads,
-                &mut saved,
-                &EDMP_GUIDES,
-                steps,
-                &cfg,
-                &mut checks,
-            )
-            .map(|()| (paths, checks.free))
+            refine_batch(&scene, &cfg, steps, stale)
         };
         let free_rows = [[false; 6], [true; 6]].concat();
         // One free row is enough: nothing moves, and the judge is told which rows are free.

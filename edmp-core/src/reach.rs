@@ -38,7 +38,7 @@ pub fn motion(reach: &[f32; JOINTS], step: &[f32; JOINTS]) -> f32 {
 /// `√x` rounded up (x ≥ 0), at compile time: Newton's iteration from above, then a relative
 /// margin far above f32's rounding.
 const fn sqrt_above(x: f32) -> f32 {
-    if !(x > 0.0) {
+    if x.is_nan() || x <= 0.0 {
         return 0.0;
     }
     let mut y = if x > 1.0 { x } else { 1.0 };
