@@ -9,7 +9,7 @@ use edmp_core::checker::CheckConfig;
 use edmp_core::geometry::{BoxFrame, CylinderBox};
 use edmp_core::global::GlobalConfig;
 use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES};
-use edmp_core::planner::{GuidanceSchedule, PlanConfig, RefineStop, Workspace, plan};
+use edmp_core::planner::{GuidanceSchedule, Judging, PlanConfig, RefineStop, Workspace, plan};
 use edmp_core::prior::{HORIZON, Sampler, Scratch};
 use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
@@ -103,6 +103,7 @@ fuzz_target!(|data: &[u8]| {
         refine_stop: None,
         refine_guide: None,
         step_control: false,
+        judging: Judging::Every,
     };
     let count = [1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)];
     let mut scratch = Box::new(Scratch::<4>::new());
@@ -118,6 +119,9 @@ fuzz_target!(|data: &[u8]| {
     // The optimizer's ablations: step-size control, the clearance refinement, a smoothness term.
     let extra = r.byte();
     config.step_control = extra & 1 != 0;
+    if extra & 8 != 0 {
+        config.judging = Judging::Winner;
+    }
     if extra & 2 != 0 {
         config.refine_guide = Some(CLEARANCE_GUIDE);
     }
@@ -143,5 +147,7 @@ fuzz_target!(|data: &[u8]| {
             assert_eq!(path[HORIZON - 1], goal);
         }
         assert!(p.verdicts.iter().all(|v| v.swept.is_finite() && v.swept >= 0.0));
+        // The chosen candidate is always judged, whichever candidates the judge skipped.
+        assert!(p.verdicts.get(p.best).is_some_and(|v| v.checked));
     }
 });
