@@ -126,24 +126,17 @@ const fn body_reach() -> [[f32; JOINTS]; BODIES] {
 mod tests {
     use super::*;
     use crate::kinematics::forward;
+    use crate::rng::Rng;
     use crate::robot::PANDA;
-
-    /// A deterministic stream of numbers in [0, 1).
-    fn uniform(seed: &mut u64) -> f32 {
-        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (*seed >> 40) as f32 / (1u64 << 24) as f32
-    }
 
     #[test]
     fn no_hull_point_moves_farther_than_the_bound() {
-        let mut seed = 7u64;
+        let mut rng = Rng::new(7);
         let mut worst = 0.0f32;
         for _ in 0..400 {
-            let q: [f32; JOINTS] = core::array::from_fn(|j| {
-                PANDA.soft_lower[j] + uniform(&mut seed) * (PANDA.soft_upper[j] - PANDA.soft_lower[j])
-            });
-            let scale = 0.3 * uniform(&mut seed);
-            let q2: [f32; JOINTS] = core::array::from_fn(|j| q[j] + scale * (2.0 * uniform(&mut seed) - 1.0));
+            let q: [f32; JOINTS] = core::array::from_fn(|j| rng.uniform_f32(PANDA.soft_lower[j], PANDA.soft_upper[j]));
+            let scale = rng.uniform_f32(0.0, 0.3);
+            let q2: [f32; JOINTS] = core::array::from_fn(|j| q[j] + scale * rng.uniform_f32(-1.0, 1.0));
             let (a, b) = (forward::<f32>(&q).unwrap(), forward::<f32>(&q2).unwrap());
             for (body, reach) in BODY_REACH.iter().enumerate() {
                 let frame = PANDA.bodies[body].frame;

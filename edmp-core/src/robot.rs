@@ -81,8 +81,7 @@ include!(concat!(env!("OUT_DIR"), "/panda.rs"));
 /// The Panda in `f32`: what the planner uses.
 // The tables are written once at f64 precision; the compiler rounds each literal to f32 here.
 // URDF numbers such as the hardware limit -3.1416 are data, not approximations of π.
-#[allow(clippy::excessive_precision, clippy::approx_constant)]
-pub static PANDA: Robot<f32> = panda_tables!();
+pub static PANDA: Robot<f32> = PANDA_TABLES;
 /// The same tables as a constant, for tables derived from them at compile time
 /// ([`crate::reach`]; a `static` cannot be read there).
 #[allow(clippy::excessive_precision, clippy::approx_constant)]
