@@ -331,13 +331,13 @@ impl<'s, const N: usize> Prepared<'s, N> {
         let obstacle_radius = obstacles.map(|o| o.bounding_radius());
         let shapes = if scene.held().is_some() { SLOTS } else { BODIES };
         let radius = core::array::from_fn(|b| match (PANDA.bodies.get(b), scene.held()) {
-            (Some(body), _) => libm::sqrtf(body.half_extents.norm_squared()),
+            (Some(body), _) => crate::float::sqrt(body.half_extents.norm_squared()),
             (None, Some(h)) => Primitive::obstacle(h).bounding_radius(),
             (None, None) => 0.0,
         });
         // The held object's points lie within |centre| + its ball's radius of the hand's origin.
         let held_extent = scene.held().map_or(0.0, |h| {
-            (libm::sqrtf(h.center.norm_squared()) + Primitive::obstacle(h).bounding_radius()) * (1.0 + 1e-5)
+            (crate::float::sqrt(h.center.norm_squared()) + Primitive::obstacle(h).bounding_radius()) * (1.0 + 1e-5)
         });
         let reach = core::array::from_fn(|b| match BODY_REACH.get(b) {
             Some(r) => *r,

@@ -69,7 +69,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     }
     let mut radius = [0.0f32; BODIES];
     for (r, body) in radius.iter_mut().zip(PANDA.bodies.iter()) {
-        *r = libm::sqrtf(body.half_extents.norm_squared());
+        *r = crate::float::sqrt(body.half_extents.norm_squared());
     }
 
     let mut gradient = gradient;
@@ -90,7 +90,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
                                centers: [&Vector3<f32>; 2],
                                radius: f32| {
                 let mid = (centers[0] + centers[1]) * 0.5;
-                let radius = radius + 0.5 * libm::sqrtf((centers[1] - centers[0]).norm_squared());
+                let radius = radius + 0.5 * crate::float::sqrt((centers[1] - centers[0]).norm_squared());
                 let swept = Union(ends);
                 for (o, &reach) in obstacles.iter().zip(&reach) {
                     let limit = radius + reach;
@@ -196,7 +196,7 @@ fn write_gradient<const H: usize>(
 
 /// Whether `a` is proven more than `clearance` from `b` along GJK's vector `v` (from `b` to `a`).
 fn apart_by<A: Convex>(a: &A, b: &Primitive, v: &Vector3<f32>, clearance: f32) -> bool {
-    let len = libm::sqrtf(v.norm_squared());
+    let len = crate::float::sqrt(v.norm_squared());
     len > 0.0 && len.is_finite() && gap_along(a, b, &(v / len)) >= clearance
 }
 
@@ -223,7 +223,7 @@ impl Convex for Union<'_> {
 /// centres' direction `towards` (see the module docs).
 fn signed_gap<A: Convex>(a: &A, b: &Primitive, towards: &Vector3<f32>) -> (f32, Vector3<f32>) {
     if let Some(v) = closest(a, b, towards) {
-        let len = libm::sqrtf(v.norm_squared());
+        let len = crate::float::sqrt(v.norm_squared());
         if len > 0.0 && len.is_finite() {
             let n = v / len;
             return (gap_along(a, b, &n), n);
@@ -236,7 +236,7 @@ fn signed_gap<A: Convex>(a: &A, b: &Primitive, towards: &Vector3<f32>) -> (f32, 
             best = (gap, n);
         }
     };
-    let len = libm::sqrtf(towards.norm_squared());
+    let len = crate::float::sqrt(towards.norm_squared());
     if len > 0.0 && len.is_finite() {
         consider(towards / len);
     }
@@ -310,7 +310,7 @@ mod tests {
         }
         assert!(checked >= 4, "some joints move the arm towards the wall");
         // A small step down the gradient lowers the cost.
-        let norm = libm::sqrtf(g.iter().flatten().map(|v| v * v).sum::<f32>());
+        let norm = crate::float::sqrt(g.iter().flatten().map(|v| v * v).sum::<f32>());
         let mut next = x;
         for (q, gq) in next.iter_mut().zip(&g) {
             for (v, gv) in q.iter_mut().zip(gq) {
@@ -350,7 +350,7 @@ mod tests {
             let mut g = [[0.0; JOINTS]; H];
             let c = trajectory_cost(&scene, &x, 0.03, Some(&mut g)).unwrap();
             assert!(c.is_finite() && c >= 0.0);
-            let norm = libm::sqrtf(g.iter().flatten().map(|v| v * v).sum::<f32>());
+            let norm = crate::float::sqrt(g.iter().flatten().map(|v| v * v).sum::<f32>());
             if norm == 0.0 {
                 continue;
             }

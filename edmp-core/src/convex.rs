@@ -88,8 +88,8 @@ impl Primitive {
     /// Radius of a ball around `center` that holds the primitive.
     pub fn bounding_radius(&self) -> f32 {
         match self.shape {
-            Shape::Cuboid { dims } => 0.5 * libm::sqrtf(dims.norm_squared()),
-            Shape::Cylinder { radius, height } => libm::sqrtf(radius * radius + 0.25 * height * height),
+            Shape::Cuboid { dims } => 0.5 * crate::float::sqrt(dims.norm_squared()),
+            Shape::Cylinder { radius, height } => crate::float::sqrt(radius * radius + 0.25 * height * height),
             Shape::Sphere { radius } => radius,
         }
     }
@@ -107,7 +107,7 @@ impl Convex for Primitive {
                 Vector3::new(sign(local.x) * dims.x, sign(local.y) * dims.y, sign(local.z) * dims.z) * 0.5
             }
             Shape::Sphere { radius } => {
-                let n = libm::sqrtf(local.norm_squared());
+                let n = crate::float::sqrt(local.norm_squared());
                 if n > 0.0 {
                     local * (radius / n)
                 } else {
@@ -115,7 +115,7 @@ impl Convex for Primitive {
                 }
             }
             Shape::Cylinder { radius, height } => {
-                let n = libm::sqrtf(local.x * local.x + local.y * local.y);
+                let n = crate::float::sqrt(local.x * local.x + local.y * local.y);
                 let (x, y) = if n > 0.0 {
                     (local.x * radius / n, local.y * radius / n)
                 } else {

@@ -193,7 +193,7 @@ impl RobotBox {
 
 /// `|half|`, the radius of a box's ball.
 fn radius_of(half: &Vector3<f32>) -> f32 {
-    libm::sqrtf(half.norm_squared())
+    crate::float::sqrt(half.norm_squared())
 }
 
 /// The held object's box in the hand frame.

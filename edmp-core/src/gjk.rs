@@ -113,7 +113,7 @@ pub fn apart_by<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -
 
 /// [`apart_by`] from the direction in `hint` only.
 fn apart_from<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> Option<f32> {
-    let len = libm::sqrtf(hint.norm_squared());
+    let len = crate::float::sqrt(hint.norm_squared());
     if len > 0.0 {
         let gap = gap_along(a, b, &(*hint / len));
         if gap > margin {
@@ -123,7 +123,7 @@ fn apart_from<A: Convex, B: Convex>(a: &A, b: &B, margin: f32, hint: &mut V) -> 
     let mut start = *hint;
     for _ in 0..RESTARTS {
         let v = closest(a, b, &start)?;
-        let len = libm::sqrtf(v.norm_squared());
+        let len = crate::float::sqrt(v.norm_squared());
         if !(len > 0.0 && len.is_finite()) {
             return None;
         }
@@ -173,7 +173,7 @@ pub fn distance_lower_bound<A: Convex, B: Convex>(a: &A, b: &B) -> f32 {
         let Some(v) = closest(a, b, &start) else {
             break;
         };
-        let len = libm::sqrtf(v.norm_squared());
+        let len = crate::float::sqrt(v.norm_squared());
         if !(len > 0.0 && len.is_finite()) {
             break;
         }
@@ -294,7 +294,7 @@ fn nearest_on_tetrahedron(s: &Simplex) -> (V, Kept) {
     let faces: [[u8; 4]; 4] = [[0, 1, 2, 3], [0, 1, 3, 2], [0, 2, 3, 1], [1, 2, 3, 0]];
     let (ab, ac, ad) = (s[1] - s[0], s[2] - s[0], s[3] - s[0]);
     let volume = ab.dot(&ac.cross(&ad));
-    let scale = libm::sqrtf(ab.norm_squared() * ac.norm_squared() * ad.norm_squared());
+    let scale = crate::float::sqrt(ab.norm_squared() * ac.norm_squared() * ad.norm_squared());
     let solid = volume.abs() > FLAT * scale;
     if !solid {
         // A flat tetrahedron (support points of a curved surface bunch up) cannot enclose the

@@ -254,7 +254,7 @@ fn step_rows<const H: usize, const N: usize>(
         let scale = if !guide.normalize {
             step
         } else if norm2 > 0.0 && norm2.is_finite() {
-            step / libm::sqrtf(norm2)
+            step / crate::float::sqrt(norm2)
         } else if norm2 == 0.0 {
             if let Some(flag) = settled.get_mut(g) {
                 *flag = true;

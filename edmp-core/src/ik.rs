@@ -94,7 +94,7 @@ impl core::error::Error for IkError {}
 pub fn rotation_error(target: &Matrix3<f32>, current: &Matrix3<f32>) -> Vector3<f32> {
     let e = target * current.transpose();
     let v = Vector3::new(e[(2, 1)] - e[(1, 2)], e[(0, 2)] - e[(2, 0)], e[(1, 0)] - e[(0, 1)]) * 0.5;
-    let sin = libm::sqrtf(v.norm_squared());
+    let sin = crate::float::sqrt(v.norm_squared());
     let cos = ((e.trace() - 1.0) * 0.5).clamp(-1.0, 1.0);
     let angle = libm::atan2f(sin, cos);
     if sin > 1e-6 {
@@ -113,7 +113,7 @@ pub fn rotation_error(target: &Matrix3<f32>, current: &Matrix3<f32>) -> Vector3<
         2
     };
     let axis = b.column(k).into_owned();
-    let n = libm::sqrtf(axis.norm_squared());
+    let n = crate::float::sqrt(axis.norm_squared());
     if n > 0.0 {
         axis * (core::f32::consts::PI / n)
     } else {
@@ -165,7 +165,7 @@ fn descend(target: &Pose<f32>, mut q: Joints<f32>, config: &IkConfig) -> Result<
         let tcp = k.tcp();
         let dp = target.translation - tcp.translation;
         let dw = rotation_error(&target.rotation, &tcp.rotation);
-        let (pe, re) = (libm::sqrtf(dp.norm_squared()), libm::sqrtf(dw.norm_squared()));
+        let (pe, re) = (crate::float::sqrt(dp.norm_squared()), crate::float::sqrt(dw.norm_squared()));
         if pe <= config.position_tolerance && re <= config.rotation_tolerance {
             return Ok(Some(IkSolution {
                 joints: q,

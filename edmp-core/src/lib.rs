@@ -24,6 +24,7 @@ pub mod convex;
 pub mod cost;
 pub mod error;
 pub mod executor;
+pub mod float;
 pub mod geometry;
 pub mod gjk;
 pub mod global;

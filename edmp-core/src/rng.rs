@@ -44,7 +44,7 @@ impl Rng {
     pub fn normal_f32(&mut self) -> f32 {
         let u1 = 1.0 - self.unit_f32(); // (0, 1]: the logarithm stays finite
         let u2 = self.unit_f32();
-        libm::sqrtf(-2.0 * libm::logf(u1)) * libm::cosf(2.0 * core::f32::consts::PI * u2)
+        crate::float::sqrt(-2.0 * libm::logf(u1)) * libm::cosf(2.0 * core::f32::consts::PI * u2)
     }
 }
 

@@ -96,7 +96,7 @@ fn positive(values: &[f32]) -> Result<(), SceneError> {
 /// A quaternion `[w, x, y, z]` whose norm is within tolerance of 1, as a rotation matrix.
 pub fn rotation_from_wxyz(q: [f32; 4]) -> Result<Matrix3<f32>, SceneError> {
     finite(&q)?;
-    let norm = libm::sqrtf(q.iter().map(|v| v * v).sum::<f32>());
+    let norm = crate::float::sqrt(q.iter().map(|v| v * v).sum::<f32>());
     if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
         return Err(SceneError::QuaternionNorm);
     }

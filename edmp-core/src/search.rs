@@ -663,7 +663,7 @@ fn distance2(a: &Joints<f32>, b: &Joints<f32>) -> f32 {
 /// Euclidean length of a two-point window (0 for any other length).
 pub(crate) fn segment_length(w: &[Joints<f32>]) -> f32 {
     match w {
-        [a, b] => libm::sqrtf(distance2(a, b)),
+        [a, b] => crate::float::sqrt(distance2(a, b)),
         _ => 0.0,
     }
 }
@@ -1090,7 +1090,7 @@ mod tests {
         assert_eq!((even[0], even[HORIZON - 1]), (poly[0], poly[3]));
         let total = 2.3f32;
         for w in even.windows(2) {
-            let d = libm::sqrtf(distance2(&w[0], &w[1]));
+            let d = crate::float::sqrt(distance2(&w[0], &w[1]));
             assert!(d <= total / SPANS as f32 + 1e-5, "{d}");
         }
         let kept = resample_through_vertices(&poly).unwrap();

@@ -155,7 +155,7 @@ impl Sampler {
                 };
                 let beta = 1.0 - abar(step.t) / abar(step.prev);
                 let (a, c) = (
-                    1.0 / libm::sqrtf(1.0 - beta),
+                    1.0 / crate::float::sqrt(1.0 - beta),
                     beta / generated::SQRT_ONE_MINUS_ALPHA_BAR[i],
                 );
                 for (xw, ew) in x.iter_mut().zip(eps) {

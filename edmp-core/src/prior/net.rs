@@ -768,7 +768,7 @@ fn norm_mish(x: &mut [f32], channels: usize, lay: Layout, gamma: &[f32], beta: &
             for c in rows.clone() {
                 var += run(c).iter().fold(0.0f32, |a, v| a + (v - mean) * (v - mean));
             }
-            let inv = 1.0 / libm::sqrtf(var / count + 1e-5);
+            let inv = 1.0 / crate::float::sqrt(var / count + 1e-5);
             for c in rows {
                 let (Some(&ga), Some(&be)) = (gamma.get(c), beta.get(c)) else {
                     continue;

@@ -309,7 +309,7 @@ fn fill<const N: usize, const H: usize>(
     let mut time = 0.0f32;
     let mut prev = 0.0f32;
     for (i, (x, t)) in out.x.iter().zip(out.t.iter_mut()).take(k + 1).enumerate() {
-        let speed = libm::sqrtf(*x);
+        let speed = crate::float::sqrt(*x);
         if i > 0 {
             time += du2 / (prev + speed);
         }
@@ -356,7 +356,7 @@ fn demand<const H: usize>(curve: &Curve<'_, H>, law: Law, limits: &JointLimits, 
             rj = rj.max((d3 * v * v * v + 3.0 * d2 * v * law.a + d1 * law.j).abs() / jl);
         }
     }
-    rv.max(libm::sqrtf(ra)).max(libm::cbrtf(rj))
+    rv.max(crate::float::sqrt(ra)).max(libm::cbrtf(rj))
 }
 
 /// Largest [`demand`] at the given fractions of every piece of the law.
@@ -401,7 +401,7 @@ fn time_scale<const H: usize>(curve: &Curve<'_, H>, profile: &Profile<'_>, limit
 fn safe_scale<const H: usize>(curve: &Curve<'_, H>, profile: &Profile<'_>, limits: &JointLimits, jerk: bool) -> f32 {
     let [q1, q2, q3] = curve.derivative_bounds();
     let x_max = profile.x.iter().fold(0.0f32, |m, x| m.max(*x));
-    let u1 = libm::sqrtf(x_max);
+    let u1 = crate::float::sqrt(x_max);
     let u2 = profile.x.windows(2).fold(0.0f32, |m, w| {
         m.max((w.last().copied().unwrap_or(0.0) - w.first().copied().unwrap_or(0.0)).abs())
     }) * profile.m
@@ -416,5 +416,5 @@ fn safe_scale<const H: usize>(curve: &Curve<'_, H>, profile: &Profile<'_>, limit
             rj = rj.max((g(&q3) * u1 * u1 * u1 + 3.0 * g(&q2) * u1 * u2 + g(&q1) * u3) / g(&limits.jerk));
         }
     }
-    rv.max(libm::sqrtf(ra)).max(libm::cbrtf(rj)).max(1.0) * (1.0 + 1e-3)
+    rv.max(crate::float::sqrt(ra)).max(libm::cbrtf(rj)).max(1.0) * (1.0 + 1e-3)
 }

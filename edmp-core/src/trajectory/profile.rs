@@ -62,7 +62,7 @@ impl Profile<'_> {
         let t0 = self.t.get(i).copied().unwrap_or(0.0);
         let x0 = self.x.get(i).copied().unwrap_or(0.0);
         let x1 = self.x.get(i + 1).copied().unwrap_or(0.0);
-        (t0, i as f32 / self.m, libm::sqrtf(x0), (x1 - x0) * self.m * 0.5)
+        (t0, i as f32 / self.m, crate::float::sqrt(x0), (x1 - x0) * self.m * 0.5)
     }
 
     /// The raw profile at `τ`: (u, u̇, ü).

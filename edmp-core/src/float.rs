@@ -1,0 +1,24 @@
+//! Square roots for the hot paths: `libm`'s, the same bits everywhere, called so that x86-64
+//! does not stall on them.
+//!
+//! On x86-64 `libm::sqrtf` is inline assembly of the legacy-SSE `sqrtss`. Inlined among the
+//! AVX code of an x86-64-v3 build, it runs while the upper halves of the vector registers are
+//! dirty and waits on them (`perf`: GroupNorm's one square root per group was a third of its
+//! block's time, and the network 14 % faster without it). Behind a call that is never inlined,
+//! the compiler clears the upper halves (`vzeroupper`) before the call and the instruction runs
+//! clean. Elsewhere (a Cortex-M) the call is inlined as usual. Either way it is the same
+//! function: a correctly rounded square root, the same bits as before and on every target.
+
+/// `√x`, correctly rounded (`libm::sqrtf`); NaN below 0, as `libm`.
+#[cfg(target_arch = "x86_64")]
+#[inline(never)]
+pub fn sqrt(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
+/// `√x`, correctly rounded (`libm::sqrtf`); NaN below 0, as `libm`.
+#[cfg(not(target_arch = "x86_64"))]
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
