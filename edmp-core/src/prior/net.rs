@@ -536,13 +536,16 @@ fn conv_tile<const CO: usize, const K: usize>(
     taps: usize,
 ) -> [[f32; TILE]; CO] {
     let mut acc = [[0.0f32; TILE]; CO];
-    // Per input channel: its `K · CO` weights, then tap by tap a window of `TILE` inputs.
+    // The inputs one channel's taps read: `taps` windows of `TILE`.
+    let span = taps.min(K) + TILE - 1;
+    // Per input channel: its `K · CO` weights, then tap by tap a window of `TILE` inputs. The
+    // zip of exact chunks and windows is a counted loop: no check per tap.
     for (ci, w) in weights.chunks_exact(K * CO).take(cin).enumerate() {
-        let Some(x_row) = input.get(ci * row..) else {
+        let Some(x_span) = input.get(ci * row..ci * row + span) else {
             break;
         };
-        for (kk, w_k) in w.chunks_exact(CO).take(taps).enumerate() {
-            let Some(x) = x_row.get(kk..).and_then(|r| r.first_chunk::<TILE>()) else {
+        for (w_k, x) in w.chunks_exact(CO).zip(x_span.windows(TILE)) {
+            let Some(x) = x.first_chunk::<TILE>() else {
                 break;
             };
             for (acc_c, w_c) in acc.iter_mut().zip(w_k) {
@@ -614,11 +617,13 @@ fn conv_rows<const CO: usize, const K: usize, const S: usize>(
     let row_out = lay_out.row();
     let shift = PAD - K / 2;
     let taps = conv.cin * K;
-    for c in 0..CO {
-        let w = conv.weights.get((co0 + c) * taps..(co0 + c + 1) * taps).unwrap_or(&[]);
-        for (t, w) in w.iter().enumerate() {
-            if let Some(slot) = wbuf.get_mut(t * CO + c) {
-                *slot = f32::from(*w as i8);
+    if let Some(tile) = wbuf.get_mut(..taps * CO) {
+        for c in 0..CO {
+            let w = conv.weights.get((co0 + c) * taps..(co0 + c + 1) * taps).unwrap_or(&[]);
+            for (at_tap, w) in tile.chunks_exact_mut(CO).zip(w) {
+                if let Some(slot) = at_tap.get_mut(c) {
+                    *slot = f32::from(*w as i8);
+                }
             }
         }
     }
