@@ -165,7 +165,10 @@ fn descend(target: &Pose<f32>, mut q: Joints<f32>, config: &IkConfig) -> Result<
         let tcp = k.tcp();
         let dp = target.translation - tcp.translation;
         let dw = rotation_error(&target.rotation, &tcp.rotation);
-        let (pe, re) = (crate::float::sqrt(dp.norm_squared()), crate::float::sqrt(dw.norm_squared()));
+        let (pe, re) = (
+            crate::float::sqrt(dp.norm_squared()),
+            crate::float::sqrt(dw.norm_squared()),
+        );
         if pe <= config.position_tolerance && re <= config.rotation_tolerance {
             return Ok(Some(IkSolution {
                 joints: q,

@@ -103,6 +103,9 @@ pub struct Tuning {
     /// Global stage: nodes per search tree (the host holds at most 4096).
     #[arg(long, default_value_t = SearchConfig::DEFAULT.max_nodes)]
     search_nodes: u16,
+    /// Global stage: searches tried, each from fresh trees, until one finds a path (1-4).
+    #[arg(long, default_value_t = GlobalConfig::DEFAULT.attempts, value_parser = clap::value_parser!(u8).range(1..=4))]
+    search_attempts: u8,
     /// Weight of a smoothness term in every guide's step (the bending energy of the path;
     /// 0: EDMP's guides; below 0.125). An ablation (docs/benchmark.md).
     #[arg(long, default_value_t = 0.0)]
@@ -185,6 +188,7 @@ impl Tuning {
                         max_nodes: self.search_nodes,
                         ..SearchConfig::DEFAULT
                     },
+                    attempts: self.search_attempts,
                     ..GlobalConfig::DEFAULT
                 })
             },
@@ -250,13 +254,17 @@ impl Tuning {
         } else {
             "no step limit".to_owned()
         };
-        let defaults = (SearchConfig::DEFAULT.max_iterations, SearchConfig::DEFAULT.max_nodes);
+        let defaults = (
+            SearchConfig::DEFAULT.max_iterations,
+            SearchConfig::DEFAULT.max_nodes,
+            GlobalConfig::DEFAULT.attempts,
+        );
         let boxes = if self.no_global {
             format!("{boxes}, no global stage")
-        } else if (self.search_iterations, self.search_nodes) != defaults {
+        } else if (self.search_iterations, self.search_nodes, self.search_attempts) != defaults {
             format!(
-                "{boxes}, search {} iterations × {} nodes",
-                self.search_iterations, self.search_nodes
+                "{boxes}, search {} iterations × {} nodes × {} attempts",
+                self.search_iterations, self.search_nodes, self.search_attempts
             )
         } else {
             boxes.to_owned()
@@ -472,6 +480,7 @@ pub fn plan_document(
             "found": s.found,
             "nodes": s.nodes,
             "iterations": s.iterations,
+            "attempts": s.attempts,
             "segment_checks": s.segment_checks,
         })),
         "shortcut": plan.shortcut.map(|s| json!({
