@@ -103,6 +103,10 @@ pub struct Tuning {
     /// Global stage: nodes per search tree (the host holds at most 4096).
     #[arg(long, default_value_t = SearchConfig::DEFAULT.max_nodes)]
     search_nodes: u16,
+    /// Global stage: random shortcut attempts on the search's raw path before it is resampled
+    /// and reseeded.
+    #[arg(long, default_value_t = SearchConfig::DEFAULT.shortcuts)]
+    search_shortcuts: u32,
     /// Global stage: searches tried, each from fresh trees, until one finds a path (1-4).
     #[arg(long, default_value_t = GlobalConfig::DEFAULT.attempts, value_parser = clap::value_parser!(u8).range(1..=4))]
     search_attempts: u8,
@@ -186,6 +190,7 @@ impl Tuning {
                     search: SearchConfig {
                         max_iterations: self.search_iterations,
                         max_nodes: self.search_nodes,
+                        shortcuts: self.search_shortcuts,
                         ..SearchConfig::DEFAULT
                     },
                     attempts: self.search_attempts,
@@ -257,14 +262,21 @@ impl Tuning {
         let defaults = (
             SearchConfig::DEFAULT.max_iterations,
             SearchConfig::DEFAULT.max_nodes,
+            SearchConfig::DEFAULT.shortcuts,
             GlobalConfig::DEFAULT.attempts,
+        );
+        let search = (
+            self.search_iterations,
+            self.search_nodes,
+            self.search_shortcuts,
+            self.search_attempts,
         );
         let boxes = if self.no_global {
             format!("{boxes}, no global stage")
-        } else if (self.search_iterations, self.search_nodes, self.search_attempts) != defaults {
+        } else if search != defaults {
             format!(
-                "{boxes}, search {} iterations × {} nodes × {} attempts",
-                self.search_iterations, self.search_nodes, self.search_attempts
+                "{boxes}, search {} iterations × {} nodes, {} shortcuts, {} attempts",
+                search.0, search.1, search.2, search.3
             )
         } else {
             boxes.to_owned()
