@@ -456,7 +456,18 @@ fn mish(x: f32) -> f32 {
 /// step of 2 × 10⁻⁵), far below the int8 weights' error; the same bits on every target.
 #[inline(always)]
 fn mish_exp(x: f32) -> f32 {
-    let e = libm::expf(x.min(20.0) * 0.125);
+    eighth_power(mish_exp_eighth(x))
+}
+
+/// `expf(min(x, 20) / 8)`: the one call of [`mish_exp`].
+#[inline(always)]
+fn mish_exp_eighth(x: f32) -> f32 {
+    libm::expf(x.min(20.0) * 0.125)
+}
+
+/// `e⁸` by three squarings: the rest of [`mish_exp`].
+#[inline(always)]
+fn eighth_power(e: f32) -> f32 {
     let e2 = e * e;
     let e4 = e2 * e2;
     e4 * e4
@@ -782,12 +793,17 @@ fn norm_mish(x: &mut [f32], channels: usize, lay: Layout, gamma: &[f32], beta: &
                 let Some(run) = x.get_mut(lay.at(c, b, 0)..lay.at(c, b, len)) else {
                     continue;
                 };
-                for (v, e) in run.iter_mut().zip(&mut u) {
+                // Three passes, so that only the `expf` calls stay scalar: the normalization, the
+                // calls, then the squarings (a chain of three products after each call) and the
+                // rest of Mish in vectors. The same operations on the same values: the same bits.
+                for v in run.iter_mut() {
                     *v = (*v - mean) * ga + be;
-                    *e = mish_exp(*v);
+                }
+                for (v, e) in run.iter().zip(&mut u) {
+                    *e = mish_exp_eighth(*v);
                 }
                 for (v, e) in run.iter_mut().zip(&u) {
-                    *v = mish_from_exp(*v, *e);
+                    *v = mish_from_exp(*v, eighth_power(*e));
                 }
             }
         }
