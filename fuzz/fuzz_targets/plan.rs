@@ -88,6 +88,8 @@ fuzz_target!(|data: &[u8]| {
                 steps: u16::from(r.byte() % 4),
                 per_step: r.byte() % 3,
                 refine: r.byte() % 3,
+                // Fuzzed last (below).
+                attempts: 1,
             })
         },
         // Shortening of a free winner, with a fuzzed budget.
@@ -124,6 +126,10 @@ fuzz_target!(|data: &[u8]| {
     }
     if extra & 2 != 0 {
         config.refine_guide = Some(CLEARANCE_GUIDE);
+    }
+    // Searches of the global stage, 1-4 (an input that ends before this byte: 1, as before).
+    if let Some(global) = &mut config.global {
+        global.attempts = 1 + r.byte() % 4;
     }
     let mut table = EDMP_GUIDES;
     for g in &mut table {
