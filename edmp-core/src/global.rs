@@ -10,9 +10,10 @@
 //! 3. the candidates are judged as any ([`select`]); only when none is free does the search
 //!    path itself win (it passed the checker edge by edge).
 //!
-//! Worst-case work, on top of the first stage: `attempts ×` [`SearchConfig::max_oracle_calls`]
-//! segment checks, `steps` batched network forwards, `steps × per_step + refine` guidance steps over
-//! the batch, and one more selection. [`Plan::stage`] says which stage produced the winner.
+//! Worst-case work, on top of the first stage: `attempts ×`
+//! [`SearchConfig::max_oracle_calls`] segment checks, `steps` batched network forwards,
+//! `steps × per_step + refine` guidance steps over the batch, and one more selection.
+//! [`Plan::stage`] says which stage produced the winner.
 
 use crate::checker::check_segment;
 use crate::error::Error;

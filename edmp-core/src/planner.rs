@@ -835,6 +835,7 @@ mod tests {
     use super::*;
     use crate::guides::EDMP_GUIDES;
     use crate::scene::Obstacle;
+    use crate::search::SearchConfig;
     use std::boxed::Box;
 
     fn wall_scene() -> Scene<4> {
@@ -1018,6 +1019,54 @@ mod tests {
         );
         assert_eq!(a, run(&cfg));
         assert_eq!(a.fingerprint(), run(&cfg).fingerprint());
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
+    fn a_failed_search_is_tried_again_from_fresh_trees_up_to_its_attempts() {
+        // No sampling iterations: each search asks only for the direct edge, through the wall.
+        let global = |attempts: u8, iterations: u32| GlobalConfig {
+            search: SearchConfig {
+                max_iterations: iterations,
+                ..SearchConfig::DEFAULT
+            },
+            attempts,
+            ..GlobalConfig::DEFAULT
+        };
+        let cfg = |global: GlobalConfig| PlanConfig {
+            sampler: Sampler::Strided { steps: 2 },
+            guidance: GuidanceSchedule::Every { per_step: 0 },
+            global: Some(global),
+            ..config()
+        };
+        let mut scratch = Box::new(Scratch::<4>::new());
+        let mut work = Box::new(Workspace::<12>::new());
+        let mut run = |global: GlobalConfig| {
+            plan(
+                &wall_scene(),
+                &START,
+                &GOAL,
+                &EDMP_GUIDES,
+                &cfg(global),
+                &mut Rng::new(1),
+                &mut scratch,
+                &mut work,
+            )
+        };
+        for attempts in 1..=4 {
+            let report = run(global(attempts, 0)).unwrap().search.unwrap();
+            assert!(!report.found);
+            assert_eq!(
+                (report.attempts, report.segment_checks),
+                (attempts, u32::from(attempts))
+            );
+        }
+        // A search that finds the path is not repeated.
+        let found = run(global(4, SearchConfig::DEFAULT.max_iterations)).unwrap();
+        assert_eq!(found.search.map(|r| (r.found, r.attempts)), Some((true, 1)));
+        for attempts in [0, 5] {
+            assert_eq!(run(global(attempts, 0)), Err(Error::BadParameter));
+        }
     }
 
     /// [`refine`] of [`mixed_batch`] on one thread, starting from `checks`: the refined rows
