@@ -165,12 +165,8 @@ fn feature_gap<A: Convex, B: Convex>(a: &A, b: &B, towards: &V) -> f32 {
     };
     let (na, nb) = (a.face_normals(), b.face_normals());
     for normals in [na, nb].into_iter().flatten() {
-        for n in normals.column_iter() {
-            along(n.into_owned());
-        }
-    }
-    for normals in [na, nb].into_iter().flatten() {
         for e in normals.column_iter() {
+            along(e.into_owned());
             let n = towards - e * e.dot(towards);
             let len = crate::float::sqrt(n.norm_squared());
             if len > 0.0 && len.is_finite() {
