@@ -180,11 +180,15 @@ pub struct Plan<const B: usize> {
     pub shortcut: Option<ShortcutReport>,
 }
 
-/// Denoising steps of the shipped configuration ([`PlanConfig::DEFAULT`]).
-pub const DEFAULT_STEPS: u16 = 5;
+/// Denoising steps of the shipped configuration ([`PlanConfig::DEFAULT`]): three network
+/// evaluations per row (5 until 2026-12-02, ninth session: the network was 60 % of a median
+/// plan's instructions; the unguided prior's roughness rises from 0.096 to 0.141 rad, the plans'
+/// after shortening from 0.071 to 0.073; docs/benchmark.md, "Three denoising steps").
+pub const DEFAULT_STEPS: u16 = 3;
 
-/// Gradient steps per denoising step of the shipped configuration.
-pub const DEFAULT_GRADIENT_STEPS: u8 = 4;
+/// Gradient steps per denoising step of the shipped configuration (4 with five denoising
+/// steps; six with three keep the first stage's solves: 18 guided steps instead of 20).
+pub const DEFAULT_GRADIENT_STEPS: u8 = 6;
 
 /// Per-joint limit of one gradient step in the shipped configuration, radians.
 pub const DEFAULT_STEP_LIMIT: f32 = 0.1;
