@@ -24,7 +24,7 @@ use crate::planner::{Plan, PlanConfig, RowChecks, Workspace, guide_steps, judge,
 use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise_on};
 use crate::rng::Rng;
 use crate::scene::Scene;
-use crate::search::{SearchConfig, search};
+use crate::search::{SearchConfig, search_from};
 
 /// Settings of the global stage.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,6 +46,11 @@ pub struct GlobalConfig {
     pub per_step: u8,
     /// Refinement gradient steps at t = 1 afterwards.
     pub refine: u8,
+    /// Whether each search starts from the first stage's candidate with the lowest swept
+    /// volume as well as from the ends ([`search_from`]): the trees take its free stretches
+    /// from either end, and the search bridges what lies between. `false`: trees from the ends
+    /// alone, as classical RRT-Connect (until 2026-12-02, ninth session).
+    pub seeded: bool,
 }
 
 impl GlobalConfig {
@@ -57,6 +62,7 @@ impl GlobalConfig {
         steps: 3,
         per_step: 4,
         refine: 24,
+        seeded: true,
     };
 
     fn validate(&self) -> Result<(), Error> {
@@ -135,11 +141,24 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
         calls = calls.saturating_add(1);
         check_segment(scene, a, b, [start, goal], &config.check)
     };
+    // The first stage's candidate with the lowest swept volume (first on ties): the one that
+    // reaches least into the obstacles.
+    let seed = if global.seeded {
+        let mut best: Option<(f32, &Path)> = None;
+        for (x, v) in plan.paths.iter().zip(&plan.verdicts) {
+            if best.is_none_or(|(swept, _)| v.swept < swept) {
+                best = Some((v.swept, x));
+            }
+        }
+        best.map_or(&[][..], |(_, x)| &x[..])
+    } else {
+        &[]
+    };
     let mut found = None;
     let mut attempts = 0u8;
     while found.is_none() && attempts < global.attempts {
         attempts += 1;
-        found = search(start, goal, &global.search, &mut work.search, rng, &mut edge_free)?;
+        found = search_from(start, goal, seed, &global.search, &mut work.search, rng, &mut edge_free)?;
     }
     let report = |found: bool, nodes: usize, iterations: u32| SearchReport {
         found,

@@ -1028,13 +1028,15 @@ mod tests {
     #[test]
     #[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
     fn a_failed_search_is_tried_again_from_fresh_trees_up_to_its_attempts() {
-        // No sampling iterations: each search asks only for the direct edge, through the wall.
+        // No sampling iterations and no seed: each search asks only for the direct edge,
+        // through the wall.
         let global = |attempts: u8, iterations: u32| GlobalConfig {
             search: SearchConfig {
                 max_iterations: iterations,
                 ..SearchConfig::DEFAULT
             },
             attempts,
+            seeded: false,
             ..GlobalConfig::DEFAULT
         };
         let cfg = |global: GlobalConfig| PlanConfig {

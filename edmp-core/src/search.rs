@@ -42,6 +42,10 @@ const NO_NODE: u16 = u16::MAX;
 /// Segments of the output path.
 const SPANS: usize = HORIZON - 1;
 
+/// Failing oracle calls a seed path may add to a search: its chain from each root, and the
+/// connect of the goal tree to the start chain's tip.
+const SEED_FAILS: u64 = 3;
+
 /// Oracle calls of the two verifications (even resampling, then the vertex-keeping fallback).
 const VERIFY_CALLS: u64 = 2 * SPANS as u64;
 
@@ -81,19 +85,21 @@ impl SearchConfig {
     /// Worst-case calls of `edge_free` in one [`search`] with a space of `capacity` nodes per
     /// tree (`N = tree_capacity(capacity)`):
     ///
-    /// `1 + max_iterations + 2 (N − 1) + shortcuts + 2 (HORIZON − 1)`.
+    /// `1 + max_iterations + 3 + 2 (N − 1) + shortcuts + 2 (HORIZON − 1)`.
     ///
     /// Why: one call for the direct start–goal edge; during growth every call either adds a
     /// node (at most `N − 1` per tree) or fails, and each iteration has at most one failing
     /// call (its extension, or the connect that follows it, stops at the first blocked edge);
-    /// one call per shortcut attempt; `HORIZON − 1` calls to verify the evenly resampled path
-    /// and as many again for the vertex-keeping fallback. Besides the oracle, each extension
-    /// scans its tree for the nearest node (at most `N` distances).
+    /// a seed path ([`search_from`]) adds at most three failing calls (the chain from each
+    /// root, then the connect of the goal tree to the start chain's tip); one call per shortcut
+    /// attempt; `HORIZON − 1` calls to verify the evenly resampled path and as many again for
+    /// the vertex-keeping fallback. Besides the oracle, each extension scans its tree for the
+    /// nearest node (at most `N` distances).
     pub const fn max_oracle_calls(&self, capacity: usize) -> u64 {
         let nodes = self.tree_capacity(capacity) as u64;
         let growth = (self.max_iterations as u64).saturating_add(nodes.saturating_sub(1).saturating_mul(2));
         growth
-            .saturating_add(1)
+            .saturating_add(1 + SEED_FAILS)
             .saturating_add(self.shortcuts as u64)
             .saturating_add(VERIFY_CALLS)
     }
@@ -197,6 +203,26 @@ pub fn search<const CAP: usize>(
     rng: &mut Rng,
     edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
 ) -> Result<Option<SearchOutcome>, Error> {
+    search_from(start, goal, &[], config, space, rng, edge_free)
+}
+
+/// [`search`] with trees that start from a seed path as well as from their roots: the start
+/// tree takes the seed's waypoints from the start on, each under the previous one, as long as
+/// the edge to it is free; the goal tree likewise from the goal back; then the goal tree
+/// tries to connect to the start chain's tip, as after any extension. A candidate of the
+/// prior that collides in one place thus leaves the search only the gap around that place
+/// to bridge, instead of the whole way. The seed's first and last waypoints stand for the
+/// ends (they are not read); waypoints outside the soft limits end a chain (the trees stay
+/// within them). No randomness is used by the seeding: with an empty seed this is [`search`].
+pub fn search_from<const CAP: usize>(
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    seed: &[Joints<f32>],
+    config: &SearchConfig,
+    space: &mut SearchSpace<CAP>,
+    rng: &mut Rng,
+    edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+) -> Result<Option<SearchOutcome>, Error> {
     check_finite(start)?;
     check_finite(goal)?;
     check_within_limits(start)?;
@@ -218,7 +244,18 @@ pub fn search<const CAP: usize>(
         space.len = [1, 1];
         2
     } else {
-        let Some((s, g)) = grow(start, goal, config, capacity, space, rng, &mut oracle, &mut iterations)? else {
+        let Some((s, g)) = grow(
+            start,
+            goal,
+            seed,
+            config,
+            capacity,
+            space,
+            rng,
+            &mut oracle,
+            &mut iterations,
+        )?
+        else {
             return Ok(None);
         };
         join(space, s, g)
@@ -370,6 +407,7 @@ where
 fn grow<const CAP: usize, F>(
     start: &Joints<f32>,
     goal: &Joints<f32>,
+    seed: &[Joints<f32>],
     config: &SearchConfig,
     capacity: usize,
     space: &mut SearchSpace<CAP>,
@@ -399,6 +437,18 @@ where
     };
     s.plant(start);
     g.plant(goal);
+    let inner = seed.get(1..seed.len().saturating_sub(1)).unwrap_or(&[]);
+    let tip = grow_chain(&mut s, inner.iter(), oracle)?;
+    grow_chain(&mut g, inner.iter().rev(), oracle)?;
+    if let Some(tip) = tip
+        && let Some(target) = s.grown().get(tip).copied()
+    {
+        match connect(&mut g, &target, config.step, oracle)? {
+            Connect::Full => return Ok(None),
+            Connect::Trapped => {}
+            Connect::Reached(j) => return Ok(Some((tip, j))),
+        }
+    }
     let mut from_start = true;
     while *iterations < config.max_iterations {
         *iterations = iterations.saturating_add(1);
@@ -413,19 +463,76 @@ where
             Extension::Advanced(i) | Extension::Reached(i) => Some(i),
         };
         if let Some((i, target)) = new.and_then(|i| a.grown().get(i).map(|q| (i, *q))) {
-            // Greedy connect: each pass adds a node or ends, so at most `capacity` passes.
-            loop {
-                match extend(b, &target, config.step, oracle)? {
-                    Extension::Full => return Ok(None),
-                    Extension::Trapped => break,
-                    Extension::Advanced(_) => {}
-                    Extension::Reached(j) => return Ok(Some(if from_start { (i, j) } else { (j, i) })),
-                }
+            match connect(b, &target, config.step, oracle)? {
+                Connect::Full => return Ok(None),
+                Connect::Trapped => {}
+                Connect::Reached(j) => return Ok(Some(if from_start { (i, j) } else { (j, i) })),
             }
         }
         from_start = !from_start;
     }
     Ok(None)
+}
+
+/// How a greedy connect ended.
+enum Connect {
+    /// The tree is at capacity: the search is over.
+    Full,
+    /// An edge towards the target is blocked.
+    Trapped,
+    /// The tree reached the target: the index of the node there.
+    Reached(usize),
+}
+
+/// Greedy connect of `tree` to `target`: extensions until one is blocked or reaches it. Each
+/// pass adds a node or ends, so at most `capacity` passes.
+fn connect<const CAP: usize, F>(
+    tree: &mut Tree<'_, CAP>,
+    target: &Joints<f32>,
+    step: f32,
+    oracle: &mut Oracle<'_, F>,
+) -> Result<Connect, Error>
+where
+    F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+{
+    loop {
+        match extend(tree, target, step, oracle)? {
+            Extension::Full => return Ok(Connect::Full),
+            Extension::Trapped => return Ok(Connect::Trapped),
+            Extension::Advanced(_) => {}
+            Extension::Reached(j) => return Ok(Connect::Reached(j)),
+        }
+    }
+}
+
+/// Appends `chain` to `tree` from its root, each waypoint under the one before, while the edge
+/// to it is free and the waypoint lies within the soft limits (a repeat of the last node is
+/// skipped); the last node added, if any.
+fn grow_chain<'c, const CAP: usize, F>(
+    tree: &mut Tree<'_, CAP>,
+    chain: impl Iterator<Item = &'c Joints<f32>>,
+    oracle: &mut Oracle<'_, F>,
+) -> Result<Option<usize>, Error>
+where
+    F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+{
+    let (mut last, mut added) = (0usize, None);
+    for q in chain {
+        let Some(from) = tree.grown().get(last).copied() else {
+            break;
+        };
+        if *q == from {
+            continue;
+        }
+        if check_finite(q).is_err() || check_within_limits(q).is_err() || !oracle.free(&from, q)? {
+            break;
+        }
+        let Some(i) = tree.push(*q, last) else {
+            break;
+        };
+        (last, added) = (i, Some(i));
+    }
+    Ok(added)
 }
 
 /// Lays the path out from the start: the start tree's chain root → `s` at flat positions
@@ -760,6 +867,35 @@ mod tests {
         (out, calls)
     }
 
+    fn run_seeded(
+        wall: Wall,
+        seed_path: &[Joints<f32>],
+        config: &SearchConfig,
+        seed: u64,
+    ) -> (Result<Option<SearchOutcome>, Error>, u64) {
+        let mut space = Box::new(SearchSpace::<256>::new());
+        let mut calls = 0u64;
+        let mut oracle = |a: &Joints<f32>, b: &Joints<f32>| {
+            calls += 1;
+            Ok(wall.edge_free(a, b))
+        };
+        let out = search_from(
+            &START,
+            &GOAL,
+            seed_path,
+            config,
+            &mut space,
+            &mut Rng::new(seed),
+            &mut oracle,
+        );
+        (out, calls)
+    }
+
+    /// `HORIZON` waypoints along the polyline through `corners`, evenly by arc length.
+    fn along(corners: &[Joints<f32>]) -> Path {
+        resample_even(corners)
+    }
+
     fn assert_valid(o: &SearchOutcome, wall: Option<Wall>) {
         let bits = |q: &Joints<f32>| q.map(f32::to_bits);
         assert_eq!(bits(&o.path[0]), bits(&START));
@@ -770,6 +906,59 @@ mod tests {
         for q in &o.path {
             assert!(PANDA.within_soft_limits(q, 1e-6), "{q:?}");
         }
+    }
+
+    #[test]
+    fn a_seed_through_the_gap_is_followed_without_sampling() {
+        // Up into the gap's band of q1, across the wall, down again: free all the way.
+        let (mut up, mut down) = (START, GOAL);
+        up[1] = 0.8;
+        down[1] = 0.8;
+        let seed_path = along(&[START, up, down, GOAL]);
+        let config = SearchConfig {
+            max_iterations: 0,
+            ..SearchConfig::DEFAULT
+        };
+        let (unseeded, _) = run::<256>(Some(GAPPED), &config, 3);
+        assert_eq!(unseeded, Ok(None), "no sampling, no path from the ends alone");
+        let (out, calls) = run_seeded(GAPPED, &seed_path, &config, 3);
+        let o = out.unwrap().expect("the seed's chains meet");
+        assert_valid(&o, Some(GAPPED));
+        assert_eq!(o.iterations, 0);
+        assert_eq!(u64::from(o.oracle_calls), calls);
+        assert!(calls <= config.max_oracle_calls(256));
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "hundreds of RRT iterations: too slow under Miri")]
+    fn a_seed_that_collides_in_the_middle_leaves_only_the_gap_to_bridge() {
+        // Straight through the wall below its gap: each chain stops at the wall.
+        let seed_path = along(&[START, GOAL]);
+        let mut seeded_iterations = 0;
+        let mut plain_iterations = 0;
+        for seed in 0..8 {
+            let (out, calls) = run_seeded(GAPPED, &seed_path, &SearchConfig::DEFAULT, seed);
+            let o = out.unwrap().expect("found");
+            assert_valid(&o, Some(GAPPED));
+            assert!(calls <= SearchConfig::DEFAULT.max_oracle_calls(256));
+            // Both chains reach the wall: 2 × 19 inner waypoints lie outside the slab.
+            assert!(o.nodes >= 2 + 2 * 19, "{}", o.nodes);
+            seeded_iterations += o.iterations;
+            let (plain, _) = run::<256>(Some(GAPPED), &SearchConfig::DEFAULT, seed);
+            plain_iterations += plain.unwrap().expect("found").iterations;
+        }
+        // Not a speed claim (the chains end at a wall here), just that seeding is no hindrance
+        // by much and the searches are not the same.
+        assert!(
+            seeded_iterations <= 2 * plain_iterations + 16,
+            "{seeded_iterations} vs {plain_iterations}"
+        );
+        // A seed with a non-finite or out-of-limits waypoint ends its chain there; no error.
+        let mut broken = seed_path;
+        broken[5][2] = f32::NAN;
+        broken[HORIZON - 6][3] = 10.0;
+        let (out, _) = run_seeded(GAPPED, &broken, &SearchConfig::DEFAULT, 1);
+        assert_valid(&out.unwrap().expect("found"), Some(GAPPED));
     }
 
     #[test]
@@ -895,7 +1084,7 @@ mod tests {
         assert_eq!(SearchConfig::DEFAULT.tree_capacity(512), 512);
         assert_eq!(
             SearchConfig::DEFAULT.max_oracle_calls(512),
-            1 + 8000 + 2 * 511 + 100 + 98
+            1 + 3 + 8000 + 2 * 511 + 100 + 98
         );
     }
 

@@ -110,6 +110,10 @@ pub struct Tuning {
     /// Global stage: searches tried, each from fresh trees, until one finds a path (1-4).
     #[arg(long, default_value_t = GlobalConfig::DEFAULT.attempts, value_parser = clap::value_parser!(u8).range(1..=4))]
     search_attempts: u8,
+    /// Global stage: grow the search's trees from the ends alone (classical RRT-Connect), not
+    /// also from the first stage's least colliding candidate. An ablation.
+    #[arg(long)]
+    no_search_seed: bool,
     /// Weight of a smoothness term in every guide's step (the bending energy of the path;
     /// 0: EDMP's guides; below 0.125). An ablation (docs/benchmark.md).
     #[arg(long, default_value_t = 0.0)]
@@ -194,6 +198,7 @@ impl Tuning {
                         ..SearchConfig::DEFAULT
                     },
                     attempts: self.search_attempts,
+                    seeded: !self.no_search_seed,
                     ..GlobalConfig::DEFAULT
                 })
             },
@@ -280,6 +285,11 @@ impl Tuning {
             )
         } else {
             boxes.to_owned()
+        };
+        let boxes = if self.no_search_seed && !self.no_global {
+            format!("{boxes}, unseeded search")
+        } else {
+            boxes
         };
         let boxes = if self.no_shortcut {
             format!("{boxes}, no shortcut")

@@ -90,6 +90,7 @@ fuzz_target!(|data: &[u8]| {
                 refine: r.byte() % 3,
                 // Fuzzed last (below).
                 attempts: 1,
+                seeded: false,
             })
         },
         // Shortening of a free winner, with a fuzzed budget.
@@ -128,8 +129,10 @@ fuzz_target!(|data: &[u8]| {
         config.refine_guide = Some(CLEARANCE_GUIDE);
     }
     // Searches of the global stage, 1-4 (an input that ends before this byte: 1, as before).
+    // Then whether the search is seeded (an input that ends before it: unseeded, as before).
     if let Some(global) = &mut config.global {
         global.attempts = 1 + r.byte() % 4;
+        global.seeded = r.byte() & 1 == 1;
     }
     let mut table = EDMP_GUIDES;
     for g in &mut table {
