@@ -101,6 +101,13 @@ pub struct PlanConfig {
     pub step_control: bool,
     /// Which candidates the exact checker judges ([`Judging`]).
     pub judging: Judging,
+    /// Distinct draws of noise the rows start from (1 ..= B; B or more: a draw per row, as
+    /// EDMP; 0 counts as 1): row `r` starts from draw `r mod start_draws`. The first denoising step then
+    /// runs the network once per draw, not once per row; rows that share a draw part at its
+    /// update, which adds noise of its own to each (at K = 3, t = 255 → 170: β' z with
+    /// β' = 0.76), and at their guides. Each row alone is still a sample of the same process;
+    /// what is given up is the independence of rows in the first step (diversity: ACSM).
+    pub start_draws: u8,
 }
 
 /// Which candidates the exact checker judges once the guides are done. The winner, its path
@@ -221,6 +228,7 @@ impl PlanConfig {
         refine_guide: None,
         step_control: false,
         judging: Judging::Winner,
+        start_draws: u8::MAX,
     };
 }
 
@@ -613,6 +621,17 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
     Ok(())
 }
 
+/// Copies row `r mod draws` into every row `r ≥ draws`.
+fn spread_draws<const B: usize>(rows: &mut [Path; B], draws: usize) {
+    for r in draws.max(1)..B {
+        if let Some(&from) = rows.get(r % draws.max(1))
+            && let Some(to) = rows.get_mut(r)
+        {
+            *to = from;
+        }
+    }
+}
+
 /// A candidate as the judge sees it: every joint clamped into the soft limits, the ends exact.
 fn clamp_for_judging(x: &mut Path, start: &Joints<f32>, goal: &Joints<f32>) {
     for q in x.iter_mut() {
@@ -661,19 +680,29 @@ pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, c
     if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) {
         return Err(Error::BadParameter);
     }
-    for x in paths.iter_mut() {
+    // Rows `0..draws` draw; row r copies row r mod draws.
+    let draws = usize::from(config.start_draws).clamp(1, B);
+    for x in paths.iter_mut().take(draws) {
         initial_noise(x, rng, start, goal);
         if !config.condition {
             free_ends(x, rng);
         }
     }
+    spread_draws(paths, draws);
     let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16, steps: u8| {
         guide_steps(exec, scene, paths, grads, guides, t, steps, config)
     };
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
-        predict_noise_on(exec, &paths[..], &time, scratches, &mut work.eps)?;
+        if j == 0 && draws < B {
+            // Row r holds row r mod draws: so does its noise, bit for bit (a trajectory's
+            // result does not depend on its batch).
+            predict_noise_on(exec, &paths[..draws], &time, scratches, &mut work.eps[..draws])?;
+            spread_draws(&mut work.eps, draws);
+        } else {
+            predict_noise_on(exec, &paths[..], &time, scratches, &mut work.eps)?;
+        }
         for (x, e) in paths.iter_mut().zip(&work.eps) {
             if config.condition {
                 config.sampler.update(step, x, e, rng, start, goal);
@@ -870,6 +899,7 @@ mod tests {
             refine_guide: None,
             step_control: false,
             judging: Judging::Every,
+            start_draws: u8::MAX,
         }
     }
 
@@ -940,6 +970,50 @@ mod tests {
         assert_eq!(one.best, 1);
         assert!(one.verdicts[1].free && one.verdicts[1].colliding_states == 0);
         assert!(!one.verdicts[0].free && one.verdicts[0].colliding_states == 1);
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the network over a batch: too slow under Miri")]
+    fn rows_that_share_a_draw_share_the_first_step_bit_for_bit() {
+        // One denoising step (t = 255 → 0 adds no noise) and no guidance: a row is a function
+        // of its draw alone, so rows with one draw end equal and rows with two differ.
+        let scene = wall_scene();
+        let mut scratch = Box::new(Scratch::<4>::new());
+        let mut work = Box::new(Workspace::<12>::new());
+        let mut run = |start_draws: u8| {
+            let cfg = PlanConfig {
+                sampler: Sampler::Strided { steps: 1 },
+                guidance: GuidanceSchedule::Every { per_step: 0 },
+                start_draws,
+                ..config()
+            };
+            let mut paths = [[[0.0f32; JOINTS]; HORIZON]; 12];
+            denoise(
+                &scene,
+                &START,
+                &GOAL,
+                &EDMP_GUIDES,
+                &cfg,
+                &mut Rng::new(5),
+                &mut scratch,
+                &mut work,
+                &mut paths,
+            )
+            .unwrap();
+            paths
+        };
+        let (one, three, all, more) = (run(1), run(3), run(12), run(200));
+        assert!(one.iter().all(|p| *p == one[0]));
+        for r in 0..12 {
+            for s in 0..12 {
+                assert_eq!(three[r] == three[s], r % 3 == s % 3, "rows {r} and {s}");
+                assert_eq!(all[r] == all[s], r == s, "rows {r} and {s}");
+            }
+        }
+        // Row 0's draw is the same first draw in every setting; 12 or more is a draw per row.
+        assert_eq!((one[0], three[0]), (all[0], all[0]));
+        assert_eq!(three[..3], all[..3]);
+        assert_eq!(more, all);
     }
 
     #[test]

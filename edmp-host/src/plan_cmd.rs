@@ -114,6 +114,10 @@ pub struct Tuning {
     /// also from the first stage's least colliding candidate. An ablation.
     #[arg(long)]
     no_search_seed: bool,
+    /// Distinct draws of noise the 12 rows start from (row r: draw r mod N); the first
+    /// denoising step runs the network once per draw. 12: a draw per row, as EDMP.
+    #[arg(long, default_value_t = PlanConfig::DEFAULT.start_draws.min(12), value_parser = clap::value_parser!(u8).range(1..=12))]
+    start_draws: u8,
     /// Weight of a smoothness term in every guide's step (the bending energy of the path;
     /// 0: EDMP's guides; below 0.125). An ablation (docs/benchmark.md).
     #[arg(long, default_value_t = 0.0)]
@@ -216,6 +220,7 @@ impl Tuning {
                 ..CLEARANCE_GUIDE
             }),
             step_control: self.step_control,
+            start_draws: self.start_draws,
             judging: if self.judge_every {
                 Judging::Every
             } else {
@@ -288,6 +293,11 @@ impl Tuning {
         };
         let boxes = if self.no_search_seed && !self.no_global {
             format!("{boxes}, unseeded search")
+        } else {
+            boxes
+        };
+        let boxes = if self.start_draws < 12 {
+            format!("{boxes}, {} start draws", self.start_draws)
         } else {
             boxes
         };

@@ -107,6 +107,7 @@ fuzz_target!(|data: &[u8]| {
         refine_guide: None,
         step_control: false,
         judging: Judging::Every,
+        start_draws: u8::MAX,
     };
     let count = [1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)];
     let mut scratch = Box::new(Scratch::<4>::new());
