@@ -332,6 +332,8 @@ pub struct CostMemo {
     quiet: u64,
     /// Bit `w`: waypoint `w` changed since the last evaluation ([`CostMemo::moved`]).
     moved: u64,
+    /// The cost the last evaluation returned (`+∞`: none yet).
+    last: f32,
 }
 
 impl CostMemo {
@@ -340,7 +342,14 @@ impl CostMemo {
         config: None,
         quiet: 0,
         moved: 0,
+        last: f32::INFINITY,
     };
+
+    /// The cost the last evaluation with this memo returned (`+∞` before the first): how the
+    /// refinement tells a row that still makes progress ([`crate::planner::RefineStop::stall`]).
+    pub fn last_cost(&self) -> f32 {
+        self.last
+    }
 
     /// Waypoints whose bits changed since the last evaluation (bit `w`: waypoint `w`); the caller
     /// reports every change of the row it evaluates, or calls [`CostMemo::forget`].
@@ -489,6 +498,7 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
             config: Some(*config),
             quiet,
             moved: 0,
+            last: total,
         };
     }
     if total.is_finite() {

@@ -97,6 +97,10 @@ pub struct Tuning {
     /// With `--refine-check-every`: how many free rows end the refinement (12 or more: all).
     #[arg(long, default_value_t = PlanConfig::DEFAULT.refine_stop.map_or(RefineStop::DEFAULT.free, |s| s.free))]
     refine_stop_free: u8,
+    /// With `--refine-check-every`: end the refinement at a check once this many steps have
+    /// passed since any row's guide cost last fell 5 % below its lowest (0: never).
+    #[arg(long, default_value_t = PlanConfig::DEFAULT.refine_stop.map_or(0, |s| s.stall))]
+    refine_stall: u8,
     /// Global stage: sampling iterations of the search before it gives up.
     #[arg(long, default_value_t = SearchConfig::DEFAULT.max_iterations)]
     search_iterations: u32,
@@ -214,6 +218,7 @@ impl Tuning {
             refine_stop: (self.refine_check_every > 0).then_some(RefineStop {
                 every: self.refine_check_every,
                 free: self.refine_stop_free,
+                stall: self.refine_stall,
             }),
             refine_guide: self.refine_clearance.map(|c| Guide {
                 clearance: Schedule::Constant(c),

@@ -118,6 +118,7 @@ fuzz_target!(|data: &[u8]| {
         config.refine_stop = Some(RefineStop {
             every: r.byte() % 4,
             free: r.byte() % 14,
+            stall: 0,
         });
     }
     // The optimizer's ablations: step-size control, the clearance refinement, a smoothness term.
@@ -134,6 +135,10 @@ fuzz_target!(|data: &[u8]| {
     if let Some(global) = &mut config.global {
         global.attempts = 1 + r.byte() % 4;
         global.seeded = r.byte() & 1 == 1;
+    }
+    // Then the refinement's stall stop (an input that ends before it: none, as before).
+    if let Some(stop) = &mut config.refine_stop {
+        stop.stall = r.byte() % 24;
     }
     let mut table = EDMP_GUIDES;
     for g in &mut table {
