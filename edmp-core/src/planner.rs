@@ -996,35 +996,39 @@ mod tests {
         assert!(!one.verdicts[0].free && one.verdicts[0].colliding_states == 1);
     }
 
+    /// [`denoise`] of the wall scene with EDMP's guides and seed `seed`: the 12 candidates.
+    fn denoise_wall(cfg: &PlanConfig, seed: u64) -> [Path; 12] {
+        let mut scratch = Box::new(Scratch::<4>::new());
+        let mut work = Box::new(Workspace::<12>::new());
+        let mut paths = [[[0.0f32; JOINTS]; HORIZON]; 12];
+        denoise(
+            &wall_scene(),
+            &START,
+            &GOAL,
+            &EDMP_GUIDES,
+            cfg,
+            &mut Rng::new(seed),
+            &mut scratch,
+            &mut work,
+            &mut paths,
+        )
+        .unwrap();
+        paths
+    }
+
     #[test]
     #[cfg_attr(miri, ignore = "the network over a batch: too slow under Miri")]
     fn rows_that_share_a_draw_share_the_first_step_bit_for_bit() {
         // One denoising step (t = 255 → 0 adds no noise) and no guidance: a row is a function
         // of its draw alone, so rows with one draw end equal and rows with two differ.
-        let scene = wall_scene();
-        let mut scratch = Box::new(Scratch::<4>::new());
-        let mut work = Box::new(Workspace::<12>::new());
-        let mut run = |start_draws: u8| {
+        let run = |start_draws: u8| {
             let cfg = PlanConfig {
                 sampler: Sampler::Strided { steps: 1 },
                 guidance: GuidanceSchedule::Every { per_step: 0 },
                 start_draws,
                 ..config()
             };
-            let mut paths = [[[0.0f32; JOINTS]; HORIZON]; 12];
-            denoise(
-                &scene,
-                &START,
-                &GOAL,
-                &EDMP_GUIDES,
-                &cfg,
-                &mut Rng::new(5),
-                &mut scratch,
-                &mut work,
-                &mut paths,
-            )
-            .unwrap();
-            paths
+            denoise_wall(&cfg, 5)
         };
         let (one, three, all, more) = (run(1), run(3), run(12), run(200));
         assert!(one.iter().all(|p| *p == one[0]));
@@ -1043,26 +1047,7 @@ mod tests {
     #[test]
     #[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
     fn without_conditioning_the_ends_are_written_in_only_at_the_end() {
-        let scene = wall_scene();
-        let mut scratch = Box::new(Scratch::<4>::new());
-        let mut work = Box::new(Workspace::<12>::new());
-        let mut run = |condition: bool| {
-            let cfg = PlanConfig { condition, ..config() };
-            let mut paths = [[[0.0f32; JOINTS]; HORIZON]; 12];
-            denoise(
-                &scene,
-                &START,
-                &GOAL,
-                &EDMP_GUIDES,
-                &cfg,
-                &mut Rng::new(1),
-                &mut scratch,
-                &mut work,
-                &mut paths,
-            )
-            .unwrap();
-            paths
-        };
+        let run = |condition: bool| denoise_wall(&PlanConfig { condition, ..config() }, 1);
         let (with, without) = (run(true), run(false));
         for p in with.iter().chain(without.iter()) {
             assert_eq!((p[0], p[HORIZON - 1]), (START, GOAL));
