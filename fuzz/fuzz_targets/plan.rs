@@ -140,6 +140,12 @@ fuzz_target!(|data: &[u8]| {
     if let Some(stop) = &mut config.refine_stop {
         stop.stall = r.byte() % 24;
     }
+    // Then the draws the rows start from (an input that ends before it: one per row, as before;
+    // 0 after the modulo counts as 1).
+    config.start_draws = match r.byte() {
+        0 => u8::MAX,
+        b => b % 14,
+    };
     let mut table = EDMP_GUIDES;
     for g in &mut table {
         g.smooth = if extra & 4 != 0 { 0.1 } else { 0.0 };
