@@ -33,9 +33,15 @@ run world-boxes --world-boxes
 run no-refine --refine-steps 0
 run no-step-limit --step-limit inf
 run no-conditioning --no-conditioning
-run k3 --steps 3
+run k5 --steps 5 --gradient-steps 4
 run k10 --steps 10
 run k25 --steps 25 --gradient-steps 2
+# The ninth session's switches (docs/benchmark.md): the classical search, no stall stop, rows
+# that share their first draw of noise.
+run unseeded-search --no-search-seed
+run no-stall --refine-stall 0
+run start-draws-4 --start-draws 4
+run start-draws-1 --start-draws 1
 # The original sampler (255 steps, guidance on even t), on 25 problems per family.
 run ancestral-original --ancestral --per-family 25 --refine-steps 0 --step-limit inf --world-boxes \
     --label "EDMP, ancestral K = 255, the original's costs and steps"
@@ -51,7 +57,8 @@ run guides-4 --guides 1,10,2,11
 run guides-6 --guides 1,10,2,11,4,18
 
 runs=()
-for name in edmp rrt original-strided world-boxes no-refine no-step-limit no-conditioning k3 k10 k25 \
+for name in edmp rrt original-strided world-boxes no-refine no-step-limit no-conditioning k5 k10 k25 \
+    unseeded-search no-stall start-draws-4 start-draws-1 \
     ancestral-original ancestral guides-2 guides-3 guides-4 guides-6 \
     guide-1 guide-2 guide-3 guide-4 guide-5 guide-10 guide-11 guide-13 guide-14 guide-16 guide-18 guide-21; do
     [ -f "$OUT/$name/results.jsonl" ] && runs+=("$OUT/$name")
