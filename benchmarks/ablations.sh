@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every planner run behind docs/benchmark.md and the README's planner table, then the report.
 # Runs land in bench-out/<name>/ (results.jsonl, summary.md, charts); the report in
-# docs/benchmark/. About 15 minutes on the 2-core development machine (measured: 14 min).
+# docs/benchmark/. Measured: 14 min on the 2-core development machine, before the ninth session
+# added four runs (about a minute each on the whole suite, by the ones in docs/benchmark.md).
 #   benchmarks/ablations.sh            # everything
 #   ONLY="edmp rrt" benchmarks/ablations.sh
 set -euo pipefail
