@@ -40,7 +40,9 @@ pub struct GlobalConfig {
     /// Diffusion step the search path is noised to before the prior denoises it (1 ..=
     /// `STEPS`): high enough that the prior reshapes it, low enough that it keeps its route.
     pub noise_step: u16,
-    /// Strided denoising steps from `noise_step` down (1 ..= `noise_step`).
+    /// Strided denoising steps from `noise_step` down (1 ..= `noise_step`). One since the ninth
+    /// session (three before): the same share of reseeded plans within two in 98, a twelfth
+    /// less work per global-stage plan (docs/benchmark.md).
     pub steps: u16,
     /// Gradient steps of every guide after each of those denoising steps.
     pub per_step: u8,
@@ -59,7 +61,7 @@ impl GlobalConfig {
         search: SearchConfig::DEFAULT,
         attempts: 2,
         noise_step: 50,
-        steps: 3,
+        steps: 1,
         per_step: 4,
         refine: 24,
         seeded: true,

@@ -114,6 +114,10 @@ pub struct Tuning {
     /// Global stage: searches tried, each from fresh trees, until one finds a path (1-4).
     #[arg(long, default_value_t = GlobalConfig::DEFAULT.attempts, value_parser = clap::value_parser!(u8).range(1..=4))]
     search_attempts: u8,
+    /// Global stage: strided denoising steps of the prior from the search's path noised to
+    /// step 50 (1-50), each followed by 4 gradient steps of every guide.
+    #[arg(long, default_value_t = GlobalConfig::DEFAULT.steps)]
+    global_steps: u16,
     /// Global stage: grow the search's trees from the ends alone (classical RRT-Connect), not
     /// also from the first stage's least colliding candidate. An ablation.
     #[arg(long)]
@@ -207,6 +211,7 @@ impl Tuning {
                     },
                     attempts: self.search_attempts,
                     seeded: !self.no_search_seed,
+                    steps: self.global_steps,
                     ..GlobalConfig::DEFAULT
                 })
             },
@@ -225,7 +230,12 @@ impl Tuning {
                 ..CLEARANCE_GUIDE
             }),
             step_control: self.step_control,
-            start_draws: self.start_draws,
+            // 12 is a draw per row, which the core spells u8::MAX (any batch size).
+            start_draws: if self.start_draws >= 12 {
+                u8::MAX
+            } else {
+                self.start_draws
+            },
             judging: if self.judge_every {
                 Judging::Every
             } else {
@@ -244,6 +254,13 @@ impl Tuning {
         {
             return Err(Failure::Input(format!(
                 "--refine-clearance: {c} is not a clearance in metres (finite, at least 0)"
+            )));
+        }
+        if !(1..=GlobalConfig::DEFAULT.noise_step).contains(&self.global_steps) {
+            return Err(Failure::Input(format!(
+                "--global-steps: {} outside 1..={}",
+                self.global_steps,
+                GlobalConfig::DEFAULT.noise_step
             )));
         }
         if self.refine_check_every > 0 && self.refine_stop_free == 0 {
@@ -298,6 +315,11 @@ impl Tuning {
         };
         let boxes = if self.no_search_seed && !self.no_global {
             format!("{boxes}, unseeded search")
+        } else {
+            boxes
+        };
+        let boxes = if self.global_steps != GlobalConfig::DEFAULT.steps && !self.no_global {
+            format!("{boxes}, {} reseeding steps", self.global_steps)
         } else {
             boxes
         };
@@ -637,5 +659,9 @@ mod tests {
         assert!(cli.tuning.config().is_ok_and(|c| c == PlanConfig::DEFAULT));
         let cli = Cli::parse_from(["edmp-host", "--step-limit", "0"]);
         assert!(cli.tuning.config().is_err());
+        for steps in ["0", "51"] {
+            let cli = Cli::parse_from(["edmp-host", "--global-steps", steps]);
+            assert!(cli.tuning.config().is_err(), "--global-steps {steps}");
+        }
     }
 }
