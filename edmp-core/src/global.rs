@@ -182,7 +182,7 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
     }
     let strided = Sampler::Strided { steps: global.steps };
     let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16, steps: u8| {
-        guide_steps(exec, scene, paths, grads, guides, t, steps, config)
+        guide_steps::<E, B, N>(exec, scene, paths, grads, guides, t, steps, config)
     };
     for j in 0..usize::from(global.steps) {
         let step = Step::partial(global.noise_step, global.steps, j);
@@ -200,7 +200,9 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
             guide(&mut plan.paths, &mut work.grads, step.t, global.per_step)?;
         }
     }
-    refine(
+    // Every row is reseeded: none is skipped, whatever waves the first stage ran in.
+    work.checks = RowChecks::NONE;
+    refine::<E, B, N>(
         exec,
         scene,
         start,
@@ -211,7 +213,8 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
         guides,
         global.refine,
         config,
-        &mut work.checks,
+        &mut work.checks.free,
+        &mut work.checks.touched,
     )?;
     judge(scene, start, goal, config, plan, &work.checks)?;
     plan.search = Some(searched);

@@ -108,6 +108,13 @@ pub struct PlanConfig {
     /// β' = 0.76), and at their guides. Each row alone is still a sample of the same process;
     /// what is given up is the independence of rows in the first step (diversity: ACSM).
     pub start_draws: u8,
+    /// Waves the ensemble runs in (1: one batch of every guide, as EDMP). With `waves` > 1 the
+    /// guides are dealt into waves (wave `w`: the guides `w`, `w + waves`, … of the caller's
+    /// order) and each wave is denoised and refined on its own; a later wave runs only when no
+    /// candidate of the earlier ones is free. A plan that the first wave solves costs that
+    /// wave's share of the work; its other candidates are not made ([`Verdict::made`]). Must
+    /// divide the number of guides.
+    pub waves: u8,
 }
 
 /// Which candidates the exact checker judges once the guides are done. The winner, its path
@@ -178,6 +185,10 @@ pub struct Verdict {
     /// free (the fallback ranks by it); otherwise the check of a colliding candidate stops at
     /// its first contact and this is 1. 0 exactly when `free`.
     pub colliding_states: u32,
+    /// Whether the planner made this candidate: `false` only for the rows of waves that did
+    /// not run ([`PlanConfig::waves`]); then the path is all zeros, `checked` and `free` are
+    /// `false`, `swept` is +∞ and `colliding_states` is `u32::MAX`, and it is never picked.
+    pub made: bool,
 }
 
 /// The planner's output: every candidate (row `r` followed guide `r / k`), its verdict, and the
@@ -244,6 +255,7 @@ impl PlanConfig {
         step_control: false,
         judging: Judging::Winner,
         start_draws: u8::MAX,
+        waves: 1,
     };
 }
 
@@ -257,6 +269,7 @@ impl<const B: usize> Plan<B> {
                 checked: false,
                 free: false,
                 colliding_states: 0,
+                made: true,
             }; B],
             best: 0,
             stage: Stage::None,
@@ -341,6 +354,8 @@ pub struct RowChecks<const B: usize> {
     pub free: [bool; B],
     /// The segment of each row's first contact at its last check.
     pub touched: [Option<u16>; B],
+    /// Rows of waves that did not run ([`PlanConfig::waves`]): no candidate, nothing to judge.
+    pub skipped: [bool; B],
 }
 
 impl<const B: usize> RowChecks<B> {
@@ -348,6 +363,7 @@ impl<const B: usize> RowChecks<B> {
     pub const NONE: Self = Self {
         free: [false; B],
         touched: [None; B],
+        skipped: [false; B],
     };
 }
 
@@ -481,21 +497,23 @@ pub fn polish<const B: usize, const N: usize>(
 /// moving is settled and skipped for the rest of the steps: at a fixed `t` its next step would
 /// be the same no-op, so this saves work and changes no bit ([`guide_step`]).
 #[allow(clippy::too_many_arguments)]
+/// `paths` holds at most `B` rows (a wave of them, [`PlanConfig::waves`]).
 pub(crate) fn guide_steps<E: Executor, const B: usize, const N: usize>(
     exec: &E,
     scene: &Scene<N>,
-    paths: &mut [Path; B],
-    grads: &mut [Path; B],
+    paths: &mut [Path],
+    grads: &mut [Path],
     guides: &[Guide],
     t: u16,
     steps: u8,
     config: &PlanConfig,
 ) -> Result<(), Error> {
     let mut settled = [false; B];
-    let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
+    let settled = settled.get_mut(..guides.len()).ok_or(Error::BadParameter)?;
     let mut memos = [CostMemo::NONE; B];
+    let memos = memos.get_mut(..paths.len()).ok_or(Error::BadParameter)?;
     for _ in 0..steps {
-        guide_once(exec, scene, paths, grads, guides, t, config, settled, &mut memos)?;
+        guide_once(exec, scene, paths, grads, guides, t, config, settled, memos)?;
         if settled.iter().all(|&s| s) {
             break;
         }
@@ -505,16 +523,16 @@ pub(crate) fn guide_steps<E: Executor, const B: usize, const N: usize>(
 
 /// One [`guide_step`] with the plan's step limit and boxes, its guides run by `exec`.
 #[allow(clippy::too_many_arguments)]
-fn guide_once<E: Executor, const B: usize, const N: usize>(
+fn guide_once<E: Executor, const N: usize>(
     exec: &E,
     scene: &Scene<N>,
-    paths: &mut [Path; B],
-    grads: &mut [Path; B],
+    paths: &mut [Path],
+    grads: &mut [Path],
     guides: &[Guide],
     t: u16,
     config: &PlanConfig,
     settled: &mut [bool],
-    memos: &mut [CostMemo; B],
+    memos: &mut [CostMemo],
 ) -> Result<(), Error> {
     let rule = StepRule {
         step_limit: config.step_limit,
@@ -527,35 +545,39 @@ fn guide_once<E: Executor, const B: usize, const N: usize>(
 /// The refinement: `steps` gradient steps of every row's guide at t = 1 (or of
 /// `config.refine_guide`, with step-size control if `config.step_control`), ended early by
 /// `config.refine_stop` ([`RefineStop`]); shared by the first stage and the global stage.
-/// `saved` is working memory for the step-size control.
+/// `paths` holds at most `B` rows (a wave of them, [`PlanConfig::waves`]); `saved` is working
+/// memory for the step-size control; `certified` and `touched` are what its checks learn of
+/// each row ([`RowChecks`]).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
     exec: &E,
     scene: &Scene<N>,
     start: &Joints<f32>,
     goal: &Joints<f32>,
-    paths: &mut [Path; B],
-    grads: &mut [Path; B],
-    saved: &mut [Path; B],
+    paths: &mut [Path],
+    grads: &mut [Path],
+    saved: &mut [Path],
     guides: &[Guide],
     steps: u8,
     config: &PlanConfig,
-    checks: &mut RowChecks<B>,
+    certified: &mut [bool],
+    touched: &mut [Option<u16>],
 ) -> Result<(), Error> {
-    *checks = RowChecks::NONE;
-    let RowChecks {
-        free: certified,
-        touched,
-    } = checks;
+    let rows = paths.len();
+    if rows > B || certified.len() != rows || touched.len() != rows {
+        return Err(Error::BadParameter);
+    }
+    certified.fill(false);
+    touched.fill(None);
     let every_row: [Guide; B];
     let guides = match config.refine_guide {
         Some(g) => {
             every_row = [g; B];
-            &every_row[..]
+            every_row.get(..rows).unwrap_or(&[])
         }
         None => guides,
     };
-    if guides.is_empty() || !B.is_multiple_of(guides.len()) {
+    if guides.is_empty() || !rows.is_multiple_of(guides.len()) {
         return Err(Error::BadParameter);
     }
     if let Some(stop) = config.refine_stop
@@ -563,11 +585,12 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
     {
         return Err(Error::BadParameter);
     }
-    let per_guide = B / guides.len();
+    let per_guide = rows / guides.len();
     let mut settled = [false; B];
-    let settled = settled.get_mut(..guides.len()).unwrap_or(&mut []);
+    let settled = settled.get_mut(..guides.len()).ok_or(Error::BadParameter)?;
     // One t (1) and rows moved only by the guides: each row's memo holds for the whole refinement.
     let mut memos = [CostMemo::NONE; B];
+    let memos = memos.get_mut(..rows).ok_or(Error::BadParameter)?;
     let (mut best, mut scale) = ([f32::INFINITY; B], [1.0f32; B]);
     // Each row's lowest guide cost so far, and the refinement steps since any row's fell.
     let (mut lowest, mut stalled) = ([f32::INFINITY; B], 0u16);
@@ -580,35 +603,7 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
         if let Some(stop) = config.refine_stop
             && s % stop.every == 0
         {
-            // Each row's check is its own: `exec` may run them at once. Under
-            // `Judging::Winner` a group of `exec.parts()` rows at a time, until enough are free.
-            let mut free = certified.iter().filter(|&&c| c).count();
-            let mut rows: heapless::Vec<(&Path, &mut bool, &mut Option<u16>), B> = heapless::Vec::new();
-            for ((x, done), touched) in paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut()) {
-                if !*done && rows.push((x, done, touched)).is_err() {
-                    return Err(Error::BadParameter);
-                }
-            }
-            let group = match config.judging {
-                Judging::Every => B,
-                Judging::Winner => exec.parts(),
-            };
-            for group in rows.chunks_mut(group.max(1)) {
-                if free >= usize::from(stop.free) {
-                    break;
-                }
-                exec.each(group, |(x, done, touched)| {
-                    let mut judged = **x;
-                    clamp_for_judging(&mut judged, start, goal);
-                    let from = touched.map_or(0, usize::from);
-                    let report = check_trajectory_from(scene, &judged, &config.check, from)?;
-                    **done = report.is_free();
-                    **touched = report.first_contact.map(|c| c.segment);
-                    Ok(())
-                })?;
-                free += group.iter().filter(|(_, done, _)| **done).count();
-            }
-            drop(rows);
+            let free = certify::<E, B, N>(exec, scene, start, goal, config, paths, certified, touched, stop.free)?;
             if free >= usize::from(stop.free) || (stop.stall > 0 && stalled >= u16::from(stop.stall)) {
                 return Ok(());
             }
@@ -623,15 +618,15 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
         }
         if config.step_control {
             let mut control = StepControl {
-                saved: &mut saved[..],
+                saved: saved.get_mut(..rows).ok_or(Error::BadParameter)?,
                 best: best.get_mut(..guides.len()).unwrap_or(&mut []),
                 scale: scale.get_mut(..guides.len()).unwrap_or(&mut []),
             };
             guide_step_controlled(scene, paths, grads, guides, 1, &rule, settled, &mut control)?;
         } else {
-            guide_once(exec, scene, paths, grads, guides, 1, config, settled, &mut memos)?;
+            guide_once(exec, scene, paths, grads, guides, 1, config, settled, memos)?;
             let mut progress = false;
-            for (low, memo) in lowest.iter_mut().zip(&memos) {
+            for (low, memo) in lowest.iter_mut().zip(memos.iter()) {
                 let cost = memo.last_cost();
                 progress |= cost < STALL_RATIO * *low;
                 *low = low.min(cost);
@@ -645,9 +640,55 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
     Ok(())
 }
 
+/// The exact checker's word on the rows of `paths` not yet `certified`, judged as [`judge`]
+/// will judge them (clamped into the soft limits, ends exact), each walked from where it last
+/// `touched`: the number of certified rows after it. Each row's check is its own: `exec` may
+/// run them at once. Under [`Judging::Winner`] a group of `exec.parts()` rows at a time, until
+/// `need` are certified.
+#[allow(clippy::too_many_arguments)]
+fn certify<E: Executor, const B: usize, const N: usize>(
+    exec: &E,
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    config: &PlanConfig,
+    paths: &[Path],
+    certified: &mut [bool],
+    touched: &mut [Option<u16>],
+    need: u8,
+) -> Result<usize, Error> {
+    let mut free = certified.iter().filter(|&&c| c).count();
+    let mut rows: heapless::Vec<(&Path, &mut bool, &mut Option<u16>), B> = heapless::Vec::new();
+    for ((x, done), touched) in paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut()) {
+        if !*done && rows.push((x, done, touched)).is_err() {
+            return Err(Error::BadParameter);
+        }
+    }
+    let group = match config.judging {
+        Judging::Every => B,
+        Judging::Winner => exec.parts(),
+    };
+    for group in rows.chunks_mut(group.max(1)) {
+        if free >= usize::from(need) {
+            break;
+        }
+        exec.each(group, |(x, done, touched)| {
+            let mut judged = **x;
+            clamp_for_judging(&mut judged, start, goal);
+            let from = touched.map_or(0, usize::from);
+            let report = check_trajectory_from(scene, &judged, &config.check, from)?;
+            **done = report.is_free();
+            **touched = report.first_contact.map(|c| c.segment);
+            Ok(())
+        })?;
+        free += group.iter().filter(|(_, done, _)| **done).count();
+    }
+    Ok(free)
+}
+
 /// Copies row `r mod draws` into every row `r ≥ draws`.
-fn spread_draws<const B: usize>(rows: &mut [Path; B], draws: usize) {
-    for r in draws.max(1)..B {
+fn spread_draws(rows: &mut [Path], draws: usize) {
+    for r in draws.max(1)..rows.len() {
         if let Some(&from) = rows.get(r % draws.max(1))
             && let Some(to) = rows.get_mut(r)
         {
@@ -701,11 +742,118 @@ pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, c
     config.sampler.validate()?;
     check_joints(start)?;
     check_joints(goal)?;
-    if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) {
+    let waves = usize::from(config.waves);
+    if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) || waves == 0 || !guides.len().is_multiple_of(waves)
+    {
         return Err(Error::BadParameter);
     }
+    let per_wave = guides.len() / waves;
+    let rows = B / waves;
+    // The guides in the order the waves run them (wave w: guides w, w + waves, w + 2·waves, …,
+    // so that each wave mixes the caller's order), the rows likewise: wave w denoises rows
+    // `w·rows .. (w + 1)·rows` of `paths`, which are put back in the caller's order at the end.
+    let Some(&first) = guides.first() else {
+        return Err(Error::BadParameter);
+    };
+    let mut order = [first; B];
+    for (slot, g) in order.iter_mut().zip(wave_order(guides.len(), waves)) {
+        *slot = guides.get(g).copied().ok_or(Error::BadParameter)?;
+    }
+    work.checks = RowChecks::NONE;
+    let Workspace {
+        eps, grads, checks, ..
+    } = work;
+    let mut ran = 0;
+    for w in 0..waves {
+        let (Some(wave_guides), Some(x), Some(e), Some(d), Some(free), Some(touched)) = (
+            order.get(w * per_wave..(w + 1) * per_wave),
+            paths.get_mut(w * rows..(w + 1) * rows),
+            eps.get_mut(w * rows..(w + 1) * rows),
+            grads.get_mut(w * rows..(w + 1) * rows),
+            checks.free.get_mut(w * rows..(w + 1) * rows),
+            checks.touched.get_mut(w * rows..(w + 1) * rows),
+        ) else {
+            return Err(Error::BadParameter);
+        };
+        denoise_wave::<E, B, N, C>(
+            exec,
+            scene,
+            start,
+            goal,
+            wave_guides,
+            config,
+            rng,
+            scratches,
+            (x, e, d),
+            (free, touched),
+        )?;
+        ran = w + 1;
+        // A later wave runs only when no row of this one is free (the judge would check them
+        // the same way; what is learnt here it does not check again).
+        if ran < waves && certify::<E, B, N>(exec, scene, start, goal, config, x, free, touched, 1)? > 0 {
+            break;
+        }
+    }
+    for skipped in checks.skipped.iter_mut().skip(ran * rows) {
+        *skipped = true;
+    }
+    if waves > 1 {
+        let k = B / guides.len();
+        // Row `r` of the caller's order is row `wave_row(r)` of the waves' order.
+        let mut source = [0usize; B];
+        for (r, src) in source.iter_mut().enumerate() {
+            let (g, i) = (r / k, r % k);
+            let (w, j) = (g % waves, g / waves);
+            *src = (w * per_wave + j) * k + i;
+        }
+        permute(paths, &source);
+        permute(&mut checks.free, &source);
+        permute(&mut checks.touched, &source);
+        permute(&mut checks.skipped, &source);
+    }
+    Ok(())
+}
+
+/// The caller's guide index at each slot of the waves' order: wave `w` takes guides `w`,
+/// `w + waves`, `w + 2·waves`, … (`waves` divides `guides`).
+fn wave_order(guides: usize, waves: usize) -> impl Iterator<Item = usize> {
+    let per_wave = guides / waves.max(1);
+    (0..guides).map(move |slot| (slot % per_wave.max(1)) * waves + slot / per_wave.max(1))
+}
+
+/// `items[r] = old items[source[r]]` for every `r`, in place (`source` a permutation).
+fn permute<T>(items: &mut [T], source: &[usize]) {
+    for (r, &first) in source.iter().enumerate().take(items.len()) {
+        // Follow the cycle to where the swaps before have moved the item that belongs at `r`.
+        let mut from = first;
+        while from < r {
+            from = source.get(from).copied().unwrap_or(r);
+        }
+        if from < items.len() {
+            items.swap(r, from);
+        }
+    }
+}
+
+/// One wave of [`denoise_on`]: `rows` (paths, noise predictions, gradients) follow `guides`
+/// through the denoising steps and the refinement; `checks` (certified, touched) are what the
+/// refinement's checks learn of them.
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn denoise_wave<E: Executor, const B: usize, const N: usize, const C: usize>(
+    exec: &E,
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    rng: &mut Rng,
+    scratches: &mut [Scratch<C>],
+    (paths, eps, grads): (&mut [Path], &mut [Path], &mut [Path]),
+    (certified, touched): (&mut [bool], &mut [Option<u16>]),
+) -> Result<(), Error> {
+    let rows = paths.len();
     // Rows `0..draws` draw; row r copies row r mod draws.
-    let draws = usize::from(config.start_draws).clamp(1, B);
+    let draws = usize::from(config.start_draws).clamp(1, rows.max(1));
     for x in paths.iter_mut().take(draws) {
         initial_noise(x, rng, start, goal);
         if !config.condition {
@@ -713,48 +861,38 @@ pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, c
         }
     }
     spread_draws(paths, draws);
-    let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16, steps: u8| {
-        guide_steps(exec, scene, paths, grads, guides, t, steps, config)
-    };
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
         let time = TimeEmbedding::new(step.t)?;
-        if j == 0 && draws < B {
+        if j == 0 && draws < rows {
             // Row r holds row r mod draws: so does its noise, bit for bit (a trajectory's
             // result does not depend on its batch).
-            predict_noise_on(exec, &paths[..draws], &time, scratches, &mut work.eps[..draws])?;
-            spread_draws(&mut work.eps, draws);
+            let (Some(drawn), Some(drawn_eps)) = (paths.get(..draws), eps.get_mut(..draws)) else {
+                return Err(Error::BadParameter);
+            };
+            predict_noise_on(exec, drawn, &time, scratches, drawn_eps)?;
+            spread_draws(eps, draws);
         } else {
-            predict_noise_on(exec, &paths[..], &time, scratches, &mut work.eps)?;
+            predict_noise_on(exec, paths, &time, scratches, eps)?;
         }
-        for (x, e) in paths.iter_mut().zip(&work.eps) {
+        for (x, e) in paths.iter_mut().zip(eps.iter()) {
             if config.condition {
                 config.sampler.update(step, x, e, rng, start, goal);
             } else {
                 config.sampler.advance(step, x, e, rng);
             }
         }
-        guide(paths, &mut work.grads, step.t, config.guidance.steps_at(step.t))?;
+        let steps = config.guidance.steps_at(step.t);
+        guide_steps::<E, B, N>(exec, scene, paths, grads, guides, step.t, steps, config)?;
     }
     if !config.condition {
         for x in paths.iter_mut() {
             inpaint(x, start, goal);
         }
     }
-    refine(
-        exec,
-        scene,
-        start,
-        goal,
-        paths,
-        &mut work.grads,
-        &mut work.eps,
-        guides,
-        config.refine,
-        config,
-        &mut work.checks,
-    )?;
-    Ok(())
+    refine::<E, B, N>(
+        exec, scene, start, goal, paths, grads, eps, guides, config.refine, config, certified, touched,
+    )
 }
 
 /// Clamps every candidate into the soft limits (ends exact), judges it with the exact checker
@@ -799,18 +937,31 @@ pub fn judge<const B: usize, const N: usize>(
         cylinder: config.cylinder,
         frame: config.frame,
     };
-    for (x, verdict) in paths.iter_mut().zip(verdicts.iter_mut()) {
+    for ((x, verdict), &skipped) in paths.iter_mut().zip(verdicts.iter_mut()).zip(&checks.skipped) {
+        if skipped {
+            *x = [[0.0; JOINTS]; HORIZON];
+            *verdict = Verdict {
+                swept: f32::INFINITY,
+                checked: false,
+                free: false,
+                colliding_states: u32::MAX,
+                made: false,
+            };
+            continue;
+        }
         clamp_for_judging(x, start, goal);
         *verdict = Verdict {
             swept: trajectory_cost(scene, x, &swept, None)?,
             checked: false,
             free: false,
             colliding_states: u32::MAX,
+            made: true,
         };
     }
     // Under `Judging::Winner`, the order `pick` ranks free candidates in: swept volume, then
-    // row (a selection, not a library sort: no panic path for the firmware).
-    let mut judged = [false; B];
+    // row (a selection, not a library sort: no panic path for the firmware). Rows not made
+    // count as judged.
+    let mut judged = checks.skipped;
     for _ in 0..B {
         let next = match config.judging {
             Judging::Every => judged.iter().position(|&j| !j),
@@ -881,7 +1032,9 @@ pub fn rank_in_full<const B: usize, const N: usize>(
         return Ok(());
     }
     for (x, verdict) in plan.paths.iter().zip(plan.verdicts.iter_mut()) {
-        verdict.colliding_states = check_trajectory(scene, x, &config.check, false)?.colliding_states;
+        if verdict.made {
+            verdict.colliding_states = check_trajectory(scene, x, &config.check, false)?.colliding_states;
+        }
     }
     plan.best = pick(&plan.verdicts);
     Ok(())
@@ -924,6 +1077,7 @@ mod tests {
             step_control: false,
             judging: Judging::Every,
             start_draws: u8::MAX,
+            waves: 1,
         }
     }
 
@@ -1169,7 +1323,7 @@ mod tests {
         let mut paths = mixed_batch();
         let mut grads = [[[0.0; JOINTS]; HORIZON]; 12];
         let mut saved = grads;
-        refine(
+        refine::<_, 12, 4>(
             &Serial,
             scene,
             &START,
@@ -1180,7 +1334,8 @@ mod tests {
             &EDMP_GUIDES,
             steps,
             cfg,
-            &mut checks,
+            &mut checks.free,
+            &mut checks.touched,
         )?;
         Ok((paths, checks.free))
     }
@@ -1240,6 +1395,7 @@ mod tests {
             let hinted = RowChecks {
                 free: [false; 12],
                 touched: [Some(first); 12],
+                skipped: [false; 12],
             };
             let judged = select(&scene, &START, &GOAL, &cfg, mixed_batch(), &hinted).unwrap();
             assert_eq!(judged.verdicts, plain.verdicts, "walks from segment {first}");
@@ -1335,6 +1491,7 @@ mod tests {
             let stale = RowChecks {
                 free: [true; 12],
                 touched: [Some(3); 12],
+                skipped: [false; 12],
             };
             refine_batch(&scene, &cfg, steps, stale)
         };

@@ -162,13 +162,21 @@ fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
         .verdicts
         .iter()
         .enumerate()
+        .filter(|(_, v)| v.made)
         .map(|(row, v)| Candidate {
             guide: guides[row / per_guide].id,
             free: v.checked.then_some(v.free),
             swept: v.swept,
         })
         .collect();
-    let batch: Vec<&[Joints<f32>]> = plan.paths.iter().map(|p| &p[..]).collect();
+    // The candidates made (the first waves' alone when a later one did not run).
+    let batch: Vec<&[Joints<f32>]> = plan
+        .paths
+        .iter()
+        .zip(&plan.verdicts)
+        .filter(|(_, v)| v.made)
+        .map(|(p, _)| &p[..])
+        .collect();
     Ok(Record {
         problem: problem.to_owned(),
         family: String::new(),

@@ -126,6 +126,12 @@ pub struct Tuning {
     /// denoising step runs the network once per draw. 12: a draw per row, as EDMP.
     #[arg(long, default_value_t = PlanConfig::DEFAULT.start_draws.min(12), value_parser = clap::value_parser!(u8).range(1..=12))]
     start_draws: u8,
+    /// Waves the ensemble runs in: the guides dealt into this many waves (wave w: guides w,
+    /// w + N, … of the order given), a later wave denoised only when no candidate of the
+    /// earlier ones is free. 1: one batch of every guide, as EDMP. Must divide the number of
+    /// guides; `--candidates` then lists only the candidates made.
+    #[arg(long, default_value_t = PlanConfig::DEFAULT.waves, value_parser = clap::value_parser!(u8).range(1..=12))]
+    waves: u8,
     /// Weight of a smoothness term in every guide's step (the bending energy of the path;
     /// 0: EDMP's guides; below 0.125). An ablation (docs/benchmark.md).
     #[arg(long, default_value_t = 0.0)]
@@ -170,6 +176,13 @@ impl Tuning {
             )));
         }
         let mut guides = chosen_guides(ids)?;
+        if !guides.len().is_multiple_of(usize::from(self.waves)) {
+            return Err(Failure::Input(format!(
+                "--waves: {} waves do not divide the {} guides",
+                self.waves,
+                guides.len()
+            )));
+        }
         for g in &mut guides {
             g.smooth = self.smooth;
         }
@@ -236,6 +249,7 @@ impl Tuning {
             } else {
                 self.start_draws
             },
+            waves: self.waves,
             judging: if self.judge_every {
                 Judging::Every
             } else {
@@ -325,6 +339,11 @@ impl Tuning {
         };
         let boxes = if self.start_draws < 12 {
             format!("{boxes}, {} start draws", self.start_draws)
+        } else {
+            boxes
+        };
+        let boxes = if self.waves > 1 {
+            format!("{boxes}, {} waves", self.waves)
         } else {
             boxes
         };
@@ -565,6 +584,7 @@ pub fn plan_document(
             .iter()
             .zip(&plan.verdicts)
             .enumerate()
+            .filter(|(_, (_, verdict))| verdict.made)
             .map(|(row, (path, verdict))| {
                 json!({
                     "guide": guide_of(row),
