@@ -7,6 +7,9 @@ per suite and the p95 over both. Standard library only; Linux (os.wait4).
     python3 benchmarks/user_cpu.py ROUNDS PER_FAMILY 'BINARY [plan args]' ['BINARY [plan args]' ...]
     e.g. python3 benchmarks/user_cpu.py 2 12 target/release/edmp-host 'target/release/edmp-host --refine-check-every 4'
 
+A configuration whose first argument is `rrt` runs `BINARY rrt` (the RRT-Connect baseline)
+instead of `BINARY plan`: 'target/release/edmp-host rrt'.
+
 Problems: the first PER_FAMILY of every family of benchmarks/problems and benchmarks/unseen
 (SUITES overrides the list of suite folders, space-separated).
 """
@@ -23,7 +26,8 @@ def user_seconds(command: list[str], problem: str) -> float:
         null = os.open(os.devnull, os.O_WRONLY)
         os.dup2(null, 1)
         os.dup2(null, 2)
-        os.execv(command[0], [command[0], "plan", problem, "-o", os.devnull, *command[1:]])
+        sub, args = ("rrt", command[2:]) if command[1:2] == ["rrt"] else ("plan", command[1:])
+        os.execv(command[0], [command[0], sub, problem, "-o", os.devnull, *args])
     _, _, usage = os.wait4(pid, 0)
     return usage.ru_utime
 

@@ -684,4 +684,24 @@ mod tests {
             assert!(cli.tuning.config().is_err(), "--global-steps {steps}");
         }
     }
+
+    #[test]
+    fn waves_must_divide_the_guides() {
+        let guides = |waves: &str, ids: &[u8]| {
+            let cli = Cli::parse_from(["edmp-host", "--waves", waves]);
+            cli.tuning.guides(ids).map(|g| g.len())
+        };
+        assert_eq!(guides("3", &[]).ok(), Some(12));
+        assert_eq!(guides("12", &[]).ok(), Some(12));
+        assert_eq!(guides("2", &[1, 2]).ok(), Some(2));
+        for (waves, ids) in [("5", &[][..]), ("3", &[1, 2][..])] {
+            let err = guides(waves, ids).unwrap_err();
+            assert!(
+                matches!(&err, Failure::Input(m) if m.starts_with("--waves")),
+                "{waves}: {err:?}"
+            );
+        }
+        assert!(Cli::try_parse_from(["edmp-host", "--waves", "0"]).is_err());
+        assert!(Cli::try_parse_from(["edmp-host", "--waves", "13"]).is_err());
+    }
 }

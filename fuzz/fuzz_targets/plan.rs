@@ -108,6 +108,7 @@ fuzz_target!(|data: &[u8]| {
         step_control: false,
         judging: Judging::Every,
         start_draws: u8::MAX,
+        waves: 1,
     };
     let count = [1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)];
     let mut scratch = Box::new(Scratch::<4>::new());
@@ -146,6 +147,9 @@ fuzz_target!(|data: &[u8]| {
         0 => u8::MAX,
         b => b % 14,
     };
+    // Then the waves (an input that ends before it: one, as before; 0 and 5 are refused, as
+    // are counts that do not divide the guides).
+    config.waves = [1, 2, 3, 4, 6, 12, 0, 5][usize::from(r.byte() % 8)];
     let mut table = EDMP_GUIDES;
     for g in &mut table {
         g.smooth = if extra & 4 != 0 { 0.1 } else { 0.0 };
@@ -162,12 +166,18 @@ fuzz_target!(|data: &[u8]| {
         &mut work,
     ) {
         assert!(steps >= 1);
-        for path in &p.paths {
+        for (path, verdict) in p.paths.iter().zip(&p.verdicts) {
             assert!(path.iter().flatten().all(|v| v.is_finite()));
-            assert_eq!(path[0], start);
-            assert_eq!(path[HORIZON - 1], goal);
+            if verdict.made {
+                assert_eq!(path[0], start);
+                assert_eq!(path[HORIZON - 1], goal);
+                assert!(verdict.swept.is_finite() && verdict.swept >= 0.0);
+            } else {
+                // Only rows of waves that did not run, and never the winner.
+                assert!(config.waves > 1 && !verdict.checked && !verdict.free);
+            }
         }
-        assert!(p.verdicts.iter().all(|v| v.swept.is_finite() && v.swept >= 0.0));
+        assert!(p.verdicts.get(p.best).is_some_and(|v| v.made));
         // The chosen candidate is always judged, whichever candidates the judge skipped.
         assert!(p.verdicts.get(p.best).is_some_and(|v| v.checked));
     }
