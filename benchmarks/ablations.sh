@@ -2,7 +2,8 @@
 # Every planner run behind docs/benchmark.md and the README's planner table, then the report.
 # Runs land in bench-out/<name>/ (results.jsonl, summary.md, charts); the report in
 # docs/benchmark/. Measured: 14 min on the 2-core development machine, before the ninth session
-# added four runs (about a minute each on the whole suite, by the ones in docs/benchmark.md).
+# added four runs and the tenth one (about a minute each on the whole suite, by the ones in
+# docs/benchmark.md).
 #   benchmarks/ablations.sh            # everything
 #   ONLY="edmp rrt" benchmarks/ablations.sh
 set -euo pipefail
@@ -26,9 +27,11 @@ run() {
 
 # Timings: one plan at a time on one core.
 run edmp --serial
+# The paper's one batch of 12 guides (the default deals them into 4 waves; tenth session).
+run one-batch --serial --waves 1 --label "EDMP, one batch of 12 guides (the paper's ensemble)"
 run rrt --planner rrt-connect --serial --label "RRT-Connect, 1 s budget"
 # Ablations of this project's deviations (success; both cores, so their times are not comparable).
-run original-strided --steps 10 --gradient-steps 4 --refine-steps 0 --step-limit inf --world-boxes \
+run original-strided --waves 1 --steps 10 --gradient-steps 4 --refine-steps 0 --step-limit inf --world-boxes \
     --label "EDMP, strided K = 10, the original's costs and steps"
 run world-boxes --world-boxes
 run no-refine --refine-steps 0
@@ -44,21 +47,23 @@ run no-stall --refine-stall 0
 run start-draws-4 --start-draws 4
 run start-draws-1 --start-draws 1
 # The original sampler (255 steps, guidance on even t), on 25 problems per family.
-run ancestral-original --ancestral --per-family 25 --refine-steps 0 --step-limit inf --world-boxes \
+run ancestral-original --waves 1 --ancestral --per-family 25 --refine-steps 0 --step-limit inf --world-boxes \
     --label "EDMP, ancestral K = 255, the original's costs and steps"
 run ancestral --ancestral --per-family 25
 # Table III and Figure 7: each guide alone (12 rows of it).
 for g in 1 2 3 4 5 10 11 13 14 16 18 21; do
-    run "guide-$g" --guides "$g"
+    run "guide-$g" --waves 1 --guides "$g"
 done
-# Figure 6: prefixes of the guides interleaving iv and sv (1 guide is guide-1 above).
-run guides-2 --guides 1,10
-run guides-3 --guides 1,10,2
-run guides-4 --guides 1,10,2,11
-run guides-6 --guides 1,10,2,11,4,18
+# Figure 6: prefixes of the guides interleaving iv and sv (1 guide is guide-1 above), each
+# ensemble one batch as in the paper (the 12-guide point is one-batch).
+run guides-2 --waves 1 --guides 1,10
+run guides-3 --waves 1 --guides 1,10,2
+run guides-4 --waves 1 --guides 1,10,2,11
+run guides-6 --waves 1 --guides 1,10,2,11,4,18
 
 runs=()
-for name in edmp rrt original-strided world-boxes no-refine no-step-limit no-conditioning k5 k10 k25 \
+# one-batch first: the report's tables compare the runs with its settings (one batch, as the paper).
+for name in one-batch edmp rrt original-strided world-boxes no-refine no-step-limit no-conditioning k5 k10 k25 \
     unseeded-search no-stall start-draws-4 start-draws-1 \
     ancestral-original ancestral guides-2 guides-3 guides-4 guides-6 \
     guide-1 guide-2 guide-3 guide-4 guide-5 guide-10 guide-11 guide-13 guide-14 guide-16 guide-18 guide-21; do

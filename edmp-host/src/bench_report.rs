@@ -254,6 +254,19 @@ pub fn run(args: &Args) -> Result<(), String> {
                  unless `bench --judge-every`): the free column counts them as not free."
             );
         }
+        let unmade = e
+            .records
+            .iter()
+            .filter(|r| guides.iter().any(|g| !r.candidates.iter().any(|c| c.guide == *g)))
+            .count();
+        if unmade > 0 {
+            let _ = writeln!(
+                md,
+                "\n{unmade} problems were solved before their last wave of guides ran (`PlanConfig::waves`; \
+                 `bench --waves 1` makes every guide's candidate, as the paper): the free column counts \
+                 the guides that did not run as not free."
+            );
+        }
         let names: Vec<String> = guides.iter().map(u8::to_string).collect();
         plots::grouped_bars(
             &args.out.join("winners.png"),

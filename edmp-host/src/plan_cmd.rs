@@ -126,12 +126,12 @@ pub struct Tuning {
     /// denoising step runs the network once per draw. 12: a draw per row, as EDMP.
     #[arg(long, default_value_t = PlanConfig::DEFAULT.start_draws.min(12), value_parser = clap::value_parser!(u8).range(1..=12))]
     start_draws: u8,
-    /// Waves the ensemble runs in: the guides dealt into this many waves (wave w: guides w,
-    /// w + N, … of the order given), a later wave denoised only when no candidate of the
-    /// earlier ones is free. 1: one batch of every guide, as EDMP. Must divide the number of
-    /// guides; `--candidates` then lists only the candidates made.
-    #[arg(long, default_value_t = PlanConfig::DEFAULT.waves, value_parser = clap::value_parser!(u8).range(1..=12))]
-    waves: u8,
+    /// Waves the ensemble runs in, at most: the guides dealt into the most waves up to N that
+    /// divide them evenly (wave w: guides w, w + N, … of the order given), a later wave
+    /// denoised only when no candidate of the earlier ones is free. 1: one batch of every
+    /// guide, as EDMP. Default 4; with `--candidates`, 1 (every alternative made).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=12))]
+    waves: Option<u8>,
     /// Weight of a smoothness term in every guide's step (the bending energy of the path;
     /// 0: EDMP's guides; below 0.125). An ablation (docs/benchmark.md).
     #[arg(long, default_value_t = 0.0)]
@@ -176,13 +176,6 @@ impl Tuning {
             )));
         }
         let mut guides = chosen_guides(ids)?;
-        if !guides.len().is_multiple_of(usize::from(self.waves)) {
-            return Err(Failure::Input(format!(
-                "--waves: {} waves do not divide the {} guides",
-                self.waves,
-                guides.len()
-            )));
-        }
         for g in &mut guides {
             g.smooth = self.smooth;
         }
@@ -249,7 +242,7 @@ impl Tuning {
             } else {
                 self.start_draws
             },
-            waves: self.waves,
+            waves: self.waves.unwrap_or(PlanConfig::DEFAULT.waves),
             judging: if self.judge_every {
                 Judging::Every
             } else {
@@ -342,10 +335,10 @@ impl Tuning {
         } else {
             boxes
         };
-        let boxes = if self.waves > 1 {
-            format!("{boxes}, {} waves", self.waves)
-        } else {
-            boxes
+        let boxes = match self.waves {
+            Some(1) => format!("{boxes}, one batch"),
+            Some(n) if n != PlanConfig::DEFAULT.waves => format!("{boxes}, {n} waves"),
+            _ => boxes,
         };
         let boxes = if self.no_shortcut {
             format!("{boxes}, no shortcut")
@@ -625,8 +618,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let guides = args.tuning.guides(&args.guides)?;
     let mut config = args.tuning.config()?;
     if args.candidates {
-        // Every alternative written gets its verdict.
+        // Every alternative written gets its verdict, and every one is made unless the waves
+        // were asked for.
         config.judging = Judging::Every;
+        config.waves = args.tuning.waves.unwrap_or(1);
     }
     let timed = args.timed.request()?;
 
@@ -686,21 +681,14 @@ mod tests {
     }
 
     #[test]
-    fn waves_must_divide_the_guides() {
-        let guides = |waves: &str, ids: &[u8]| {
-            let cli = Cli::parse_from(["edmp-host", "--waves", waves]);
-            cli.tuning.guides(ids).map(|g| g.len())
+    fn waves_default_to_the_cores_and_stay_within_1_to_12() {
+        let waves = |args: &[&str]| {
+            let cli = Cli::parse_from([&["edmp-host"][..], args].concat());
+            cli.tuning.config().map(|c| c.waves)
         };
-        assert_eq!(guides("3", &[]).ok(), Some(12));
-        assert_eq!(guides("12", &[]).ok(), Some(12));
-        assert_eq!(guides("2", &[1, 2]).ok(), Some(2));
-        for (waves, ids) in [("5", &[][..]), ("3", &[1, 2][..])] {
-            let err = guides(waves, ids).unwrap_err();
-            assert!(
-                matches!(&err, Failure::Input(m) if m.starts_with("--waves")),
-                "{waves}: {err:?}"
-            );
-        }
+        assert_eq!(waves(&[]).ok(), Some(PlanConfig::DEFAULT.waves));
+        assert_eq!(waves(&["--waves", "1"]).ok(), Some(1));
+        assert_eq!(waves(&["--waves", "5"]).ok(), Some(5));
         assert!(Cli::try_parse_from(["edmp-host", "--waves", "0"]).is_err());
         assert!(Cli::try_parse_from(["edmp-host", "--waves", "13"]).is_err());
     }

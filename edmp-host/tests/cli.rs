@@ -447,7 +447,9 @@ fn bench_writes_results_summary_and_charts_and_bench_report_compares_runs() {
             .unwrap(),
     )
     .unwrap();
-    assert_eq!(first["candidates"].as_array().unwrap().len(), 12);
+    // The waves that ran (three guides each, the default): their candidates alone.
+    let made = first["candidates"].as_array().unwrap().len();
+    assert!([3, 6, 9, 12].contains(&made), "{made} candidates");
     assert_eq!(first["guides"].as_array().unwrap().len(), 12);
     let run = edmp_host(&[
         "bench-report",

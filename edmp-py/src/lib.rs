@@ -92,8 +92,10 @@ fn plan(
         let began = Instant::now();
         let guides = chosen_guides(&[])?;
         let config = PlanConfig {
-            // Every alternative returned gets its verdict.
+            // Every alternative returned is made (one batch of every guide, as EDMP) and gets
+            // its verdict.
             judging: if candidates { Judging::Every } else { Judging::Winner },
+            waves: if candidates { 1 } else { PlanConfig::DEFAULT.waves },
             ..PlanConfig::DEFAULT
         };
         let planned = plan_problem(&problem, &guides, &config, seed)?;

@@ -243,7 +243,9 @@ def plan(
 ) -> Plan:
     """Plans with EDMP (the shipped configuration, as ``edmp-host plan``).
 
-    ``candidates=True`` adds every trajectory of the ensemble. ``timed=True`` adds
+    ``candidates=True`` adds every trajectory of the ensemble: all 12 guides then run as one
+    batch, as EDMP (without it the guides run in waves that stop at the first free candidate,
+    so the winner may differ; ``edmp-host plan --candidates`` does the same). ``timed=True`` adds
     ``Plan.trajectory``, as ``edmp-host plan --timed``: the path timed within Franka's velocity,
     acceleration and jerk limits times ``velocity_scale`` / ``acceleration_scale`` (each in
     (0, 1], else ``ValueError``), from rest to rest, sampled at ``rate`` Hz (at most 1000); a
