@@ -248,7 +248,7 @@ impl PlanConfig {
     /// strided sampler with [`DEFAULT_STEPS`] steps, [`DEFAULT_GRADIENT_STEPS`] gradient steps
     /// after each, [`DEFAULT_REFINE_STEPS`] refinement steps, moves limited to
     /// [`DEFAULT_STEP_LIMIT`], enclosing boxes for cylinders, obstacle-frame boxes, the
-    /// project's checker.
+    /// project's checker, the guides in four waves.
     pub const DEFAULT: Self = Self {
         sampler: Sampler::Strided { steps: DEFAULT_STEPS },
         guidance: GuidanceSchedule::Every {

@@ -147,8 +147,8 @@ fuzz_target!(|data: &[u8]| {
         0 => u8::MAX,
         b => b % 14,
     };
-    // Then the waves (an input that ends before it: one, as before; 0 and 5 are refused, as
-    // are counts that do not divide the guides).
+    // Then the waves (an input that ends before it: one, as before; 0 is refused, 5 runs as
+    // the most waves up to 5 that divide the guides).
     config.waves = [1, 2, 3, 4, 6, 12, 0, 5][usize::from(r.byte() % 8)];
     let mut table = EDMP_GUIDES;
     for g in &mut table {
