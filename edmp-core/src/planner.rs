@@ -808,12 +808,15 @@ pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, c
     }
     if waves > 1 {
         let k = B / guides.len();
-        // Row `r` of the caller's order is row `wave_row(r)` of the waves' order.
+        // Row `r` of the caller's order (guide `r / k`) is row `source[r]` of the waves' order:
+        // `wave_order` inverted, so the two orders cannot disagree.
         let mut source = [0usize; B];
-        for (r, src) in source.iter_mut().enumerate() {
-            let (g, i) = (r / k, r % k);
-            let (w, j) = (g % waves, g / waves);
-            *src = (w * per_wave + j) * k + i;
+        for (slot, g) in wave_order(guides.len(), waves).enumerate() {
+            for i in 0..k {
+                if let Some(src) = source.get_mut(g * k + i) {
+                    *src = slot * k + i;
+                }
+            }
         }
         permute(paths, &source);
         permute(&mut checks.free, &source);
