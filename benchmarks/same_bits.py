@@ -4,8 +4,9 @@ N problems of every family of both committed suites and compares the plans field
 the times (`timing_ms`) left out. For changes that must not change a plan (a faster kernel, a
 cheaper broad phase): a difference names the problem and the first field that differs.
 
-    python3 benchmarks/same_bits.py OLD_BINARY NEW_BINARY [--per-family 25] [--jobs 2] [--winner-only] \
-        [-- extra plan args]
+    python3 benchmarks/same_bits.py OLD_BINARY NEW_BINARY [--per-family 25] [--jobs 2] [--winner-only]
+    python3 benchmarks/same_bits.py [--per-family 25] [--jobs 2] [--winner-only] -- OLD_BINARY NEW_BINARY \
+        [extra plan args, e.g. --waves 4]
 
 `--winner-only` plans without `--candidates`, as a user does: the chosen plan alone, which the
 planner judges only as many candidates for as the winner needs (`Judging::Winner`).
