@@ -170,21 +170,6 @@ pub const EDMP_GUIDES: [Guide; EDMP_GUIDE_COUNT] = [
     sv(21, 0.05, E18, true, Schedule::Constant(0.10)),
 ];
 
-/// EDMP's guides by how often each frees a row on its own, most often first: the order the
-/// waves run them in ([`crate::planner::PlanConfig::waves`]; four waves: 21, 16, 14, then 10,
-/// 18, 11, then 4, 1, 2, then 13, 5, 3). Measured on 200 problems drawn afresh from the four
-/// training families (`gen-suite --seed 100000 --per-family 50`, none of the committed suites'):
-/// one batch of all 12 refined until every row is free or stalled (`bench --waves 1
-/// --judge-every --refine-stop-free 12`), rows freed 165, 163, 162, 145, 143, 138, 122, 110,
-/// 110, 101, 86, 82 times (docs/benchmark.md, eleventh session). A guide not listed runs after
-/// these, in the caller's order.
-pub const LEAD_ORDER: [u8; EDMP_GUIDE_COUNT] = [21, 16, 14, 10, 18, 11, 4, 1, 2, 13, 5, 3];
-
-/// Where guide `id` stands in [`LEAD_ORDER`] (`EDMP_GUIDE_COUNT` for a guide not in it).
-pub fn lead_rank(id: u8) -> usize {
-    LEAD_ORDER.iter().position(|&g| g == id).unwrap_or(EDMP_GUIDE_COUNT)
-}
-
 /// A guide on the exact clearance of the checker's hulls ([`CostKind::Clearance`]; not one of
 /// EDMP's): 3 cm of clearance, a normalized step of 0.05. The refinement's ablation
 /// ([`crate::planner::PlanConfig::refine_guide`]) gives it to every row.
@@ -204,14 +189,6 @@ mod tests {
 
     fn close(a: f32, b: f32) -> bool {
         (a - b).abs() <= 1e-5
-    }
-
-    #[test]
-    fn the_lead_order_ranks_every_guide_of_the_table_once() {
-        let mut ranks: [usize; EDMP_GUIDE_COUNT] = core::array::from_fn(|i| lead_rank(EDMP_GUIDES[i].id));
-        ranks.sort_unstable();
-        assert_eq!(ranks, core::array::from_fn(|i| i));
-        assert_eq!(lead_rank(CLEARANCE_GUIDE.id), EDMP_GUIDE_COUNT);
     }
 
     #[test]
