@@ -65,14 +65,18 @@ pub struct SearchConfig {
 }
 
 impl SearchConfig {
-    /// The planner's fallback setting: the host's RRT baseline's step and shortcut count, and
-    /// all of the space's capacity (a plan's bits depend on it: the host's CLI holds 4,096
-    /// nodes per tree, the firmware and `edmp-host embed` 512). 8,000 iterations: on the
-    /// suites, the problems the first stage leaves need up to about 5,300.
+    /// The planner's fallback setting: the host's RRT baseline's step, and all of the space's
+    /// capacity (a plan's bits depend on it: the host's CLI holds 4,096 nodes per tree, the
+    /// firmware and `edmp-host embed` 512). 8,000 iterations: on the suites, the problems the
+    /// first stage leaves need up to about 5,300. 25 shortcut attempts (the baseline's 100
+    /// until the eleventh session): the prior reshapes the path and the winner is shortened
+    /// again, so 75 more attempts bought nothing measurable (the same stages and path lengths
+    /// on the 127 problems that need three waves or more) for 5.5 % of a global-stage plan's
+    /// instructions (docs/benchmark.md, eleventh session).
     pub const DEFAULT: Self = Self {
         max_iterations: 8000,
         step: 0.3,
-        shortcuts: 100,
+        shortcuts: 25,
         max_nodes: u16::MAX,
     };
 
@@ -1084,7 +1088,7 @@ mod tests {
         assert_eq!(SearchConfig::DEFAULT.tree_capacity(512), 512);
         assert_eq!(
             SearchConfig::DEFAULT.max_oracle_calls(512),
-            1 + 3 + 8000 + 2 * 511 + 100 + 98
+            1 + 3 + 8000 + 2 * 511 + 25 + 98
         );
     }
 
