@@ -104,26 +104,26 @@ pub fn shorten<const N: usize>(
     let Some(corners) = polyline.get(..n) else {
         return Ok(report);
     };
+    // An unchanged polyline is the checked path itself: nothing to resample.
+    let even = (n < HORIZON).then(|| resample_even(corners));
+    let dropped = u8::try_from(HORIZON.saturating_sub(n)).unwrap_or(u8::MAX);
     // Most plans keep every smoothing pass of the evenly resampled polyline (758 of the 800
     // suite plans, 2026-12-03): that end is checked first, one full check instead of one per
     // step. Only when it fails are the steps checked one by one, as below.
-    let dropped = u8::try_from(HORIZON.saturating_sub(n)).unwrap_or(u8::MAX);
     if config.smoothing > 0 {
-        // An unchanged polyline is the checked path itself: nothing to resample.
-        let mut smoothed = if n < HORIZON { resample_even(corners) } else { *path };
+        let mut smoothed = even.unwrap_or(*path);
         for _ in 0..config.smoothing {
             smoothed = laplacian(&smoothed);
         }
         if free(&smoothed)? {
             *path = smoothed;
-            report.dropped = if n < HORIZON { dropped } else { 0 };
+            report.dropped = dropped;
             report.smoothing = config.smoothing;
             report.length_after = length(path);
             return Ok(report);
         }
     }
-    if n < HORIZON {
-        let even = resample_even(corners);
+    if let Some(even) = even {
         let candidate = if free(&even)? {
             Some(even)
         } else {
