@@ -36,10 +36,10 @@ pub struct GlobalConfig {
     /// unseen problem (window_box/080) one search of the default budget fails for 2-3 seeds in
     /// 16, its trees full before they meet; a second one mostly finds it. Only a problem whose
     /// first search failed pays for another. Four since the twelfth session (two before): over
-    /// seeds 1-16 of both suites (12,800 plans) two searches left 5 plans unsolved (cage/057,
-    /// cage/061 twice, dresser/042 twice), each search spent near its 8,000 iterations; the
-    /// third or fourth found a path for all five. No plan whose search succeeds within two
-    /// changes a bit; the five pay 0.3-1.0 s more (docs/benchmark.md).
+    /// seeds 1-16 of both suites (12,800 plans) two searches left 7 plans unsolved (cage/061
+    /// five times, window_box/047, dresser/042), every search spending its 8,000 iterations; a
+    /// third or fourth found a path for 5 of the 7. No plan whose search succeeds within two
+    /// changes a bit; those that needed more pay 0.3-1.3 s more (docs/benchmark.md).
     pub attempts: u8,
     /// Diffusion step the search path is noised to before the prior denoises it (1 ..=
     /// `STEPS`): high enough that the prior reshapes it, low enough that it keeps its route.
