@@ -39,7 +39,7 @@ pub struct GlobalConfig {
     /// seeds 1-16 of both suites (12,800 plans) two searches left 7 plans unsolved (cage/061
     /// five times, window_box/047, dresser/042), every search spending its 8,000 iterations; a
     /// third or fourth found a path for 5 of the 7. No plan whose search succeeds within two
-    /// changes a bit; those that needed more pay 0.3-1.3 s more (docs/benchmark.md).
+    /// changes a bit; those that needed more pay 0.3-1.1 s more (docs/benchmark.md).
     pub attempts: u8,
     /// Diffusion step the search path is noised to before the prior denoises it (1 ..=
     /// `STEPS`): high enough that the prior reshapes it, low enough that it keeps its route.
