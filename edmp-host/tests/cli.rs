@@ -450,6 +450,17 @@ fn bench_writes_results_summary_and_charts_and_bench_report_compares_runs() {
     // The waves that ran (three guides each, the default): their candidates alone.
     let made = first["candidates"].as_array().unwrap().len();
     assert!([3, 6, 9, 12].contains(&made), "{made} candidates");
+    // The waves that ran, and the summary's table of how the plans ended.
+    let waves = first["waves"].as_u64().unwrap();
+    assert!((1..=4).contains(&waves), "{waves} waves");
+    if first["stage"] == "diffusion" {
+        assert_eq!(made as u64, 3 * waves);
+    }
+    let summary = std::fs::read_to_string(edmp.join("summary.md")).unwrap();
+    assert!(
+        summary.contains("Where the time goes") && summary.contains("| wave "),
+        "{summary}"
+    );
     assert_eq!(first["guides"].as_array().unwrap().len(), 12);
     let run = edmp_host(&[
         "bench-report",
