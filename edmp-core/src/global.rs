@@ -4,9 +4,10 @@
 //! window or a shelf's pocket may need a detour that no gradient points to. Then
 //! 1. [`crate::search`] (RRT-Connect over the exact checker, fixed capacity, bounded
 //!    iterations) finds a collision-free coarse path;
-//! 2. the prior makes trajectories of its own from it, SDEdit-style: every row gets the path
+//! 2. the prior makes trajectories of its own from it, SDEdit-style: each row gets the path
 //!    noised to an intermediate diffusion step ([`prior::diffuse`]) and is denoised from there
-//!    with its guide, then refined, exactly as the first stage does from pure noise;
+//!    with its guide, then refined, exactly as the first stage does from pure noise, and in the
+//!    first stage's waves (`planner::in_waves`): the first wave with a free row ends it;
 //! 3. the candidates are judged as any ([`select`]); only when none is free does the search
 //!    path itself win (it passed the checker edge by edge).
 //!
@@ -20,7 +21,9 @@ use crate::error::Error;
 use crate::executor::Executor;
 use crate::guides::Guide;
 use crate::kinematics::Joints;
-use crate::planner::{Plan, PlanConfig, RowChecks, Workspace, guide_steps, judge, rank_in_full, refine, select};
+use crate::planner::{
+    Plan, PlanConfig, RowChecks, Workspace, guide_steps, in_waves, judge, rank_in_full, refine, select,
+};
 use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise_on};
 use crate::rng::Rng;
 use crate::scene::Scene;
@@ -179,46 +182,49 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
         return Ok(());
     };
     let searched = report(true, outcome.nodes, outcome.iterations);
-    // The first stage's candidates are spent: their memory holds the reseeded ones.
-    for x in plan.paths.iter_mut() {
-        *x = outcome.path;
-        prior::diffuse(x, global.noise_step, rng, start, goal);
-    }
-    let strided = Sampler::Strided { steps: global.steps };
-    let guide = |paths: &mut [Path; B], grads: &mut [Path; B], t: u16, steps: u8| {
-        guide_steps::<E, B, N>(exec, scene, paths, grads, guides, t, steps, config)
-    };
-    for j in 0..usize::from(global.steps) {
-        let step = Step::partial(global.noise_step, global.steps, j);
-        predict_noise_on(
-            exec,
-            &plan.paths[..],
-            &TimeEmbedding::new(step.t)?,
-            scratches,
-            &mut work.eps,
-        )?;
-        for (x, e) in plan.paths.iter_mut().zip(&work.eps) {
-            strided.update(step, x, e, rng, start, goal);
-        }
-        if step.t >= 5 {
-            guide(&mut plan.paths, &mut work.grads, step.t, global.per_step)?;
-        }
-    }
-    // Every row is reseeded: none is skipped, whatever waves the first stage ran in.
-    work.checks = RowChecks::NONE;
-    refine::<E, B, N>(
+    // The first stage's candidates are spent: their memory holds the reseeded ones, made in
+    // the first stage's waves (the first wave with a free row ends the reseeding too).
+    let path = outcome.path;
+    in_waves(
         exec,
         scene,
         start,
         goal,
-        &mut plan.paths,
-        &mut work.grads,
-        &mut work.eps,
         guides,
-        global.refine,
         config,
-        &mut work.checks.free,
-        &mut work.checks.touched,
+        work,
+        &mut plan.paths,
+        |wave_guides, (paths, eps, grads), (free, touched)| {
+            for x in paths.iter_mut() {
+                *x = path;
+                prior::diffuse(x, global.noise_step, rng, start, goal);
+            }
+            let strided = Sampler::Strided { steps: global.steps };
+            for j in 0..usize::from(global.steps) {
+                let step = Step::partial(global.noise_step, global.steps, j);
+                predict_noise_on(exec, paths, &TimeEmbedding::new(step.t)?, scratches, eps)?;
+                for (x, e) in paths.iter_mut().zip(eps.iter()) {
+                    strided.update(step, x, e, rng, start, goal);
+                }
+                if step.t >= 5 {
+                    guide_steps::<E, B, N>(exec, scene, paths, grads, wave_guides, step.t, global.per_step, config)?;
+                }
+            }
+            refine::<E, B, N>(
+                exec,
+                scene,
+                start,
+                goal,
+                paths,
+                grads,
+                eps,
+                wave_guides,
+                global.refine,
+                config,
+                free,
+                touched,
+            )
+        },
     )?;
     judge(scene, start, goal, config, plan, &work.checks)?;
     plan.search = Some(searched);

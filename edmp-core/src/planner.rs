@@ -754,14 +754,64 @@ pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, c
     config.sampler.validate()?;
     check_joints(start)?;
     check_joints(goal)?;
+    in_waves(
+        exec,
+        scene,
+        start,
+        goal,
+        guides,
+        config,
+        work,
+        paths,
+        |wave_guides, rows, checks| {
+            denoise_wave::<E, B, N, C>(
+                exec,
+                scene,
+                start,
+                goal,
+                wave_guides,
+                config,
+                rng,
+                scratches,
+                rows,
+                checks,
+            )
+        },
+    )
+}
+
+/// One wave's share of the batch: its rows' paths, noise predictions and gradients, and what
+/// the checks learn of them (certified, touched).
+pub(crate) type WaveRows<'a> = (&'a mut [Path], &'a mut [Path], &'a mut [Path]);
+/// The refinement's checks of one wave's rows: certified free, where each touched.
+pub(crate) type WaveChecks<'a> = (&'a mut [bool], &'a mut [Option<u16>]);
+
+/// Runs `wave` on the batch in [`PlanConfig::waves`] waves, one after another: wave `w` gives
+/// guides `w`, `w + waves`, `w + 2·waves`, … (so that each wave mixes the caller's order) their
+/// rows of `paths`; the exact checker certifies each wave's rows ([`certify`]) before the next
+/// runs, and the first wave with a free row ends it. The rows of waves not run are
+/// `RowChecks::skipped` in `work.checks` (never judged), and every row is put back in the
+/// caller's order (row r follows guide r / k whatever the waves). Shared by the first stage
+/// ([`denoise_on`]) and the global stage's reseeding ([`crate::global`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: usize>(
+    exec: &E,
+    scene: &Scene<N>,
+    start: &Joints<f32>,
+    goal: &Joints<f32>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    work: &mut Workspace<B, CAP>,
+    paths: &mut [Path; B],
+    mut wave: impl FnMut(&[Guide], WaveRows<'_>, WaveChecks<'_>) -> Result<(), Error>,
+) -> Result<(), Error> {
     if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) {
         return Err(Error::BadParameter);
     }
     let waves = config.waves_for(guides.len())?;
     let per_wave = guides.len() / waves;
     let rows = B / waves;
-    // The guides in the order the waves run them (wave w: guides w, w + waves, w + 2·waves, …,
-    // so that each wave mixes the caller's order), the rows likewise: wave w denoises rows
+    // The guides in the order the waves run them, the rows likewise: wave w runs rows
     // `w·rows .. (w + 1)·rows` of `paths`, which are put back in the caller's order at the end.
     let Some(&first) = guides.first() else {
         return Err(Error::BadParameter);
@@ -784,18 +834,7 @@ pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, c
         ) else {
             return Err(Error::BadParameter);
         };
-        denoise_wave::<E, B, N, C>(
-            exec,
-            scene,
-            start,
-            goal,
-            wave_guides,
-            config,
-            rng,
-            scratches,
-            (x, e, d),
-            (free, touched),
-        )?;
+        wave(wave_guides, (x, e, d), (free, touched))?;
         ran = w + 1;
         // A later wave runs only when no row of this one is free (the judge would check them
         // the same way; what is learnt here it does not check again).
@@ -860,8 +899,8 @@ fn denoise_wave<E: Executor, const B: usize, const N: usize, const C: usize>(
     config: &PlanConfig,
     rng: &mut Rng,
     scratches: &mut [Scratch<C>],
-    (paths, eps, grads): (&mut [Path], &mut [Path], &mut [Path]),
-    (certified, touched): (&mut [bool], &mut [Option<u16>]),
+    (paths, eps, grads): WaveRows<'_>,
+    (certified, touched): WaveChecks<'_>,
 ) -> Result<(), Error> {
     let rows = paths.len();
     // Rows `0..draws` draw; row r copies row r mod draws.
@@ -1122,6 +1161,33 @@ mod tests {
         )
     }
 
+    /// The test config with two unguided denoising steps, which leave every first-stage
+    /// candidate across the wall, and `global` to rescue them.
+    fn across_the_wall(global: GlobalConfig) -> PlanConfig {
+        PlanConfig {
+            sampler: Sampler::Strided { steps: 2 },
+            guidance: GuidanceSchedule::Every { per_step: 0 },
+            global: Some(global),
+            ..config()
+        }
+    }
+
+    /// `plan` of the wall problem with EDMP's guides, `cfg` and seed 1, in a batch of 12.
+    fn plan_wall_with(cfg: &PlanConfig) -> Result<Plan<12>, Error> {
+        let mut scratch = Box::new(Scratch::<4>::new());
+        let mut work = Box::new(Workspace::<12>::new());
+        plan(
+            &wall_scene(),
+            &START,
+            &GOAL,
+            &EDMP_GUIDES,
+            cfg,
+            &mut Rng::new(1),
+            &mut scratch,
+            &mut work,
+        )
+    }
+
     #[test]
     #[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
     fn guided_plans_go_around_a_wall_that_the_straight_line_crosses_and_repeat_bit_for_bit() {
@@ -1242,28 +1308,8 @@ mod tests {
     #[test]
     #[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
     fn the_global_stage_rescues_a_failed_first_stage_within_its_bound_and_repeats_bit_for_bit() {
-        // Two unguided denoising steps: every candidate crosses the wall.
-        let cfg = PlanConfig {
-            sampler: Sampler::Strided { steps: 2 },
-            guidance: GuidanceSchedule::Every { per_step: 0 },
-            global: Some(GlobalConfig::DEFAULT),
-            ..config()
-        };
-        let mut scratch = Box::new(Scratch::<4>::new());
-        let mut work = Box::new(Workspace::<12>::new());
-        let mut run = |cfg: &PlanConfig| {
-            plan(
-                &wall_scene(),
-                &START,
-                &GOAL,
-                &EDMP_GUIDES,
-                cfg,
-                &mut Rng::new(1),
-                &mut scratch,
-                &mut work,
-            )
-            .unwrap()
-        };
+        let cfg = across_the_wall(GlobalConfig::DEFAULT);
+        let run = |cfg: &PlanConfig| plan_wall_with(cfg).unwrap();
         let alone = run(&PlanConfig { global: None, ..cfg });
         assert!(!alone.is_free() && alone.stage == Stage::None && alone.search.is_none());
         let a = run(&cfg);
@@ -1287,6 +1333,39 @@ mod tests {
 
     #[test]
     #[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
+    fn the_reseeding_runs_in_the_first_stages_waves_up_to_the_first_free_row() {
+        // Every first-stage candidate crosses the wall, the global stage reseeds.
+        let cfg = PlanConfig {
+            judging: Judging::Winner,
+            ..across_the_wall(GlobalConfig::DEFAULT)
+        };
+        let run = |waves: u8| plan_wall_with(&PlanConfig { waves, ..cfg }).unwrap();
+        let made = |p: &Plan<12>| -> [bool; 12] { core::array::from_fn(|r| p.verdicts[r].made) };
+        // One wave: the twelve reseeded rows together, every one made.
+        let one = run(1);
+        assert_eq!(one.stage, Stage::Reseeded);
+        assert_eq!(made(&one), [true; 12]);
+        // Four: wave w (guides w, w + 4, w + 8) runs only when the waves before freed no row, so
+        // the rows made are whole waves, up to the one that holds the free winner.
+        let four = run(4);
+        assert_eq!(four.stage, Stage::Reseeded);
+        assert!(four.is_free());
+        let ran = 1 + four.best % 4;
+        assert_eq!(
+            made(&four),
+            core::array::from_fn(|r| r % 4 < ran),
+            "winner row {}",
+            four.best
+        );
+        assert!(
+            ran < 4,
+            "the reseeding ran every wave: the test no longer shows one cut short"
+        );
+        assert_eq!(four, run(4));
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
     fn a_failed_search_is_tried_again_from_fresh_trees_up_to_its_attempts() {
         // No sampling iterations and no seed: each search asks only for the direct edge,
         // through the wall.
@@ -1299,26 +1378,7 @@ mod tests {
             seeded: false,
             ..GlobalConfig::DEFAULT
         };
-        let cfg = |global: GlobalConfig| PlanConfig {
-            sampler: Sampler::Strided { steps: 2 },
-            guidance: GuidanceSchedule::Every { per_step: 0 },
-            global: Some(global),
-            ..config()
-        };
-        let mut scratch = Box::new(Scratch::<4>::new());
-        let mut work = Box::new(Workspace::<12>::new());
-        let mut run = |global: GlobalConfig| {
-            plan(
-                &wall_scene(),
-                &START,
-                &GOAL,
-                &EDMP_GUIDES,
-                &cfg(global),
-                &mut Rng::new(1),
-                &mut scratch,
-                &mut work,
-            )
-        };
+        let run = |global: GlobalConfig| plan_wall_with(&across_the_wall(global));
         for attempts in 1..=4 {
             let report = run(global(attempts, 0)).unwrap().search.unwrap();
             assert!(!report.found);
