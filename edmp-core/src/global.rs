@@ -12,8 +12,9 @@
 //!    path itself win (it passed the checker edge by edge).
 //!
 //! Worst-case work, on top of the first stage: `attempts ×`
-//! [`SearchConfig::max_oracle_calls`] segment checks, `steps` batched network forwards,
-//! `steps × per_step + refine` guidance steps over the batch, and one more selection.
+//! [`SearchConfig::max_oracle_calls`] segment checks, `steps` network forwards of each wave's
+//! rows, `steps × per_step + refine` guidance steps of each wave's rows (every row of the batch
+//! once, when no wave frees one), and one more selection.
 //! [`Plan::stage`] says which stage produced the winner.
 
 use crate::checker::check_segment;
