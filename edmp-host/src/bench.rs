@@ -408,7 +408,7 @@ fn tail_table(records: &[Record]) -> String {
         Some(n) => (0, n.parse::<u32>().unwrap_or(u32::MAX), String::new()),
         None => (
             1,
-            ["reseeded", "search", "none"].iter().position(|s| *s == o).unwrap_or(3) as u32,
+            STAGES.iter().position(|s| *s == o).unwrap_or(STAGES.len()) as u32,
             o.to_owned(),
         ),
     };
@@ -428,9 +428,11 @@ fn tail_table(records: &[Record]) -> String {
     out
 }
 
+/// The stages an EDMP plan can end in, in the order the planner reaches them.
+const STAGES: [&str; 4] = ["diffusion", "reseeded", "search", "none"];
+
 /// Which stage solved each family's problems (EDMP runs; empty for RRT-Connect).
 fn stage_table(records: &[Record]) -> String {
-    const STAGES: [&str; 4] = ["diffusion", "reseeded", "search", "none"];
     if records.iter().all(|r| r.stage.is_none()) {
         return String::new();
     }
