@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Every planner run behind docs/benchmark.md and the README's planner table, then the report.
 # Runs land in bench-out/<name>/ (results.jsonl, summary.md, charts); the report in
-# docs/benchmark/. Measured: 14 min on the 2-core development machine, before the ninth session
-# added four runs and the tenth one (about a minute each on the whole suite, by the ones in
-# docs/benchmark.md).
+# docs/benchmark/. Measured: 14 min on the 2-core development machine before the last five runs
+# were added (the unseeded search, no stall stop, two start-draw runs, the one batch: about a
+# minute each on the whole suite, by the runs in CHANGELOG.md).
 #   benchmarks/ablations.sh            # everything
 #   ONLY="edmp rrt" benchmarks/ablations.sh
 set -euo pipefail
@@ -27,7 +27,7 @@ run() {
 
 # Timings: one plan at a time on one core.
 run edmp --serial
-# The paper's one batch of 12 guides (the default deals them into 4 waves; tenth session).
+# The paper's one batch of 12 guides (the default deals them into 4 waves).
 run one-batch --serial --waves 1 --label "EDMP, one batch of 12 guides (the paper's ensemble)"
 run rrt --planner rrt-connect --serial --label "RRT-Connect, 1 s budget"
 # Ablations of this project's deviations (success; both cores, so their times are not comparable).
@@ -40,8 +40,8 @@ run no-conditioning --no-conditioning
 run k5 --steps 5 --gradient-steps 4
 run k10 --steps 10
 run k25 --steps 25 --gradient-steps 2
-# The ninth session's switches (docs/benchmark.md): the classical search, no stall stop, rows
-# that share their first draw of noise.
+# Switches of the global stage and the refinement (CHANGELOG.md, 2026-12-02): the classical
+# search, no stall stop, rows that share their first draw of noise.
 run unseeded-search --no-search-seed
 run no-stall --refine-stall 0
 run start-draws-4 --start-draws 4

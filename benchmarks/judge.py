@@ -1,6 +1,6 @@
 """The independent PyBullet judge: does each plan solve its problem?
 
-Applies `shared/spec/formats.md`, "What counts as a solved problem", to every plan with
+Applies docs/formats.md, "What counts as a solved problem", to every plan with
 PyBullet 3.2.7 and none of the project's code:
 
 1. the first waypoint equals `start` and the last the joint goal, within 1e-4 rad each; for a
@@ -102,7 +102,7 @@ ANGLE_TOLERANCE = math.radians(5.0)
 MAX_STEP = 0.01
 CLEARANCE_WITHIN = 0.01  # how far the closest-approach pass of false failures looks (m)
 HORIZON = 50
-# Franka's official limits, as spec/formats.md lists them (the URDF's safety_controller).
+# Franka's official limits, as docs/formats.md lists them (the URDF's safety_controller).
 LIMITS = [
     (-2.8973, 2.8973),
     (-1.7628, 1.7628),

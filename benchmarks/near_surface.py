@@ -1,5 +1,5 @@
 """Records the near-surface table: problems whose start or goal lies 0.05-2 mm from a surface
-by PyBullet's own measure, which `spec/formats.md` calls valid ends and which must plan.
+by PyBullet's own measure, which docs/formats.md calls valid ends and which must plan.
 
 For each of three settings (a top-down grasp over a table, a forward reach into a shelf
 pocket, a hand in front of a drawer's front panel) and each distance d, the surface nearest

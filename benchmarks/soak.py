@@ -4,8 +4,8 @@
 COUNT problems, WORKERS at a time: the committed suites (benchmarks/problems, unseen,
 near_surface) with random `--seed`s, and mutated scenes (NaN / huge / tiny / negative sizes,
 duplicated obstacles, more than 64 obstacles, ends outside the joint limits, unreachable pose
-goals, bad quaternions, unknown fields, truncated JSON, ...). Checks the spec's contract
-(shared/spec/formats.md, "Command line"):
+goals, bad quaternions, unknown fields, truncated JSON, ...). Checks the command line's contract
+(docs/formats.md, "The command line"):
 
 - no process dies by a signal, none runs past --timeout seconds (killed and counted);
 - the exit status is 0, 1 or 2, and the one the mutation calls for where it calls for one;
@@ -180,7 +180,7 @@ def run_one(job, args, kill_after):
     wrapped = [TIME, "-f", "%M", "-o", rss_file] + argv if TIME else argv
     began = time.monotonic()
     with open(err, "w") as ef:
-        # Its own session, so a timeout kills /usr/bin/time and the plan together.
+        # setsid: its own process group, so a timeout kills /usr/bin/time and the plan together.
         pid = os.posix_spawn(wrapped[0], wrapped, os.environ, setsid=True,
                              file_actions=[(os.POSIX_SPAWN_OPEN, 0, os.devnull, os.O_RDONLY, 0),
                                            (os.POSIX_SPAWN_OPEN, 1, os.devnull, os.O_WRONLY, 0),
