@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Every planner run behind docs/benchmark.md and the README's planner table, then the report.
+# Every planner run behind docs/benchmark.md's tables, then the report.
 # Runs land in bench-out/<name>/ (results.jsonl, summary.md, charts); the report in
 # docs/benchmark/. Measured: 14 min on the 2-core development machine before the last five runs
 # were added (the unseeded search, no stall stop, two start-draw runs, the one batch: about a

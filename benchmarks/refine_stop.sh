@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The ablation behind docs/benchmark.md, "Ending the refinement early": the refinement's budget
+# The ablation behind CHANGELOG.md, 2026-12-01, "the refinement ends on the checker's word": the refinement's budget
 # and its early stop (`--refine-check-every`, `--refine-stop-free`), the first stage alone
 # (`--no-global`) and the whole planner, on the first 25 problems of every family of both
 # suites. Success, path length and MRESG are what it compares (the runs are serial, but their

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """One markdown row per `edmp-host bench` run: solved, which stage solved each problem, median /
 p95 time per plan, path length and MRESG of the solved plans. For ablations side by side
-(docs/benchmark.md, "A stronger local optimizer").
+(CHANGELOG.md, 2026-12-02, "a stronger local optimizer").
 
     python3 benchmarks/stage_table.py bench-out/opt-*/unseen-*     # any number of run folders
 """
