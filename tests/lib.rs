@@ -1,7 +1,7 @@
 //! Shared helpers of the workspace-level tests: the recorded fixtures and the
 //! finite-difference oracle for the kinematics adjoint (also used by `fuzz/`).
 
-use edmp_core::kinematics::{CORNERS, CornerGradient, forward};
+use edmp_core::robot::kinematics::{CORNERS, CornerGradient, forward};
 use edmp_core::robot::{BODIES, JOINTS};
 use nalgebra::Vector3;
 use serde::Deserialize;
@@ -105,9 +105,9 @@ pub fn zero_gradient() -> CornerGradient<f32> {
 /// difference can be trusted only where the signature does not change across its stencil.
 pub mod reference {
     use core::hash::{Hash, Hasher};
+    use edmp_core::cost::boxes::{BoxFrame, box_dims};
     use edmp_core::cost::{CostConfig, CostKind};
-    use edmp_core::geometry::{BoxFrame, box_dims};
-    use edmp_core::kinematics::forward_with;
+    use edmp_core::robot::kinematics::forward_with;
     use edmp_core::robot::{BODIES, HAND_FRAME, JOINTS, PANDA};
     use edmp_core::scene::Scene;
     use nalgebra::Vector3;

@@ -5,15 +5,15 @@
 
 use core::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
-use edmp_core::checker::{CheckConfig, check_trajectory};
+use edmp_core::collision::checker::{CheckConfig, check_trajectory};
+use edmp_core::cost::boxes::{BoxFrame, CylinderBox, Inflation};
 use edmp_core::cost::{CostConfig, CostKind, CostMemo, trajectory_cost};
 use edmp_core::executor::Serial;
-use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
+use edmp_core::guidance::guides::EDMP_GUIDES;
 use edmp_core::guidance::{StepRule, guide_step_on};
-use edmp_core::guides::EDMP_GUIDES;
-use edmp_core::kinematics::forward;
 use edmp_core::rng::Rng;
 use edmp_core::robot::HAND_FRAME;
+use edmp_core::robot::kinematics::forward;
 use edmp_core::scene::{Obstacle, Scene};
 
 const H: usize = 50;

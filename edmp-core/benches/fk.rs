@@ -3,9 +3,9 @@
 
 use core::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use edmp_core::ik::{IkConfig, solve};
-use edmp_core::kinematics::{CORNERS, CornerGradient, forward};
 use edmp_core::rng::Rng;
+use edmp_core::robot::ik::{IkConfig, solve};
+use edmp_core::robot::kinematics::{CORNERS, CornerGradient, forward};
 use edmp_core::robot::{BODIES, JOINTS, PANDA};
 use edmp_core::scene::Scene;
 use nalgebra::Vector3;

@@ -2,7 +2,7 @@
 //! Run: `cargo bench -p edmp-core --bench planner`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::guidance::guides::EDMP_GUIDES;
 use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
 use edmp_core::prior::{Sampler, Scratch};
 use edmp_core::rng::Rng;

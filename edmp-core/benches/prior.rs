@@ -4,9 +4,9 @@
 
 use core::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use edmp_core::path::{HORIZON, Path};
 use edmp_core::prior::{
-    HORIZON, MACS, PARAMETERS, Path, Sampler, Scratch, TimeEmbedding, WEIGHT_BYTES, initial_noise, predict_noise,
-    sample,
+    MACS, PARAMETERS, Sampler, Scratch, TimeEmbedding, WEIGHT_BYTES, initial_noise, predict_noise, sample,
 };
 use edmp_core::rng::Rng;
 

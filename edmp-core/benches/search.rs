@@ -2,11 +2,11 @@
 //! wall scene, every edge judged by the exact checker. Run: `cargo bench -p edmp-core --bench search`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use edmp_core::checker::{CheckConfig, check_trajectory};
-use edmp_core::kinematics::Joints;
+use edmp_core::collision::checker::{CheckConfig, check_trajectory};
+use edmp_core::planner::search::{SearchConfig, SearchSpace, search};
 use edmp_core::rng::Rng;
+use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::{Obstacle, Scene};
-use edmp_core::search::{SearchConfig, SearchSpace, search};
 
 fn bench(c: &mut Criterion) {
     println!(

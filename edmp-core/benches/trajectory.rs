@@ -4,8 +4,8 @@
 
 use core::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
-use edmp_core::kinematics::Joints;
-use edmp_core::prior::HORIZON;
+use edmp_core::path::HORIZON;
+use edmp_core::robot::kinematics::Joints;
 use edmp_core::trajectory::{DEFAULT_GRID, Limits, Shape, Timed, parameterize};
 
 /// `examples/wall.json`'s plan (rounded to 6 digits).

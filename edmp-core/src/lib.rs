@@ -6,7 +6,7 @@
 //! is a typed [`Error`], never a panic or a NaN.
 //!
 //! ```
-//! use edmp_core::kinematics::forward;
+//! use edmp_core::robot::kinematics::forward;
 //! let ready = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
 //! let k = forward::<f32>(&ready).unwrap();
 //! let tcp = k.tcp().translation;
@@ -18,28 +18,18 @@
 #[cfg(test)]
 extern crate std;
 
-pub mod checker;
-pub mod clearance;
-pub mod convex;
+pub mod collision;
 pub mod cost;
 pub mod error;
 pub mod executor;
 pub mod float;
-pub mod geometry;
-pub mod gjk;
-pub mod global;
 pub mod guidance;
-pub mod guides;
-pub mod ik;
-pub mod kinematics;
+pub mod path;
 pub mod planner;
 pub mod prior;
-pub mod reach;
 pub mod rng;
 pub mod robot;
 pub mod scene;
-pub mod search;
-pub mod shortcut;
 pub mod trajectory;
 #[cfg(feature = "serde")]
 pub mod wire;

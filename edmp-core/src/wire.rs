@@ -6,7 +6,7 @@
 //! rebuilds the scene through the same [`Obstacle`] constructors the host uses, so both sides
 //! plan on the same bits. Only with the `serde` feature.
 
-use crate::kinematics::Joints;
+use crate::robot::kinematics::Joints;
 use crate::scene::{MAX_OBSTACLES, Obstacle, Scene, SceneError};
 use serde::{Deserialize, Serialize};
 

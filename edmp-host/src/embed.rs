@@ -11,7 +11,7 @@
 use crate::Failure;
 use crate::json::{joint_goal, parse_problem};
 use core::fmt::Write as _;
-use edmp_core::guides::EDMP_GUIDES;
+use edmp_core::guidance::guides::EDMP_GUIDES;
 use edmp_core::planner::{Plan, PlanConfig, Workspace, plan};
 use edmp_core::prior::Scratch;
 use edmp_core::rng::Rng;

@@ -1,7 +1,7 @@
 //! `edmp-host fk`: print the pose of every link frame and collision box for one configuration.
 
 use edmp_core::Error;
-use edmp_core::kinematics::{Joints, Pose, forward};
+use edmp_core::robot::kinematics::{Joints, Pose, forward};
 use edmp_core::robot::{BODY_NAMES, FRAME_NAMES, JOINT_NAMES, JOINTS, PANDA, TCP_FRAME};
 use serde::Serialize;
 

@@ -12,9 +12,9 @@
 use crate::rrt::{RrtConfig, path_length, plan};
 use crate::scenes::{Family, environment, neutral, reach};
 use core::time::Duration;
-use edmp_core::checker::{CheckConfig, check_trajectory};
-use edmp_core::kinematics::Joints;
+use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::rng::Rng;
+use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::MAX_OBSTACLES;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;

@@ -1,9 +1,9 @@
 //! The `edmp-scene/1` format (`shared/spec/formats.md`): parsing with errors that name the
 //! offending field by its JSON path, e.g. `obstacles[3].quaternion: norm 0.71, expected 1`.
 
-use edmp_core::checker::{CheckConfig, Contact, check_end};
-use edmp_core::ik::{IkConfig, solve};
-use edmp_core::kinematics::{Joints, Pose};
+use edmp_core::collision::checker::{CheckConfig, Contact, check_end};
+use edmp_core::robot::ik::{IkConfig, solve};
+use edmp_core::robot::kinematics::{Joints, Pose};
 use edmp_core::robot::{BODY_NAMES, FINGER_OPENING_MAX, FINGER_OPENING_MIN, JOINT_NAMES, JOINTS, PANDA};
 use edmp_core::scene::{MAX_OBSTACLES, Obstacle, QUATERNION_NORM_TOLERANCE, Scene, SceneError, rotation_from_wxyz};
 use serde_json::{Map, Value};
@@ -404,7 +404,7 @@ mod tests {
     fn the_ends_are_checked_at_the_scenes_opening() {
         // A plate between the fingers at the start: free with the fingers open, in contact closed.
         let ready = [0.0f32, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-        let k = edmp_core::kinematics::forward(&ready).unwrap();
+        let k = edmp_core::robot::kinematics::forward(&ready).unwrap();
         let hand = &k.frames[edmp_core::robot::HAND_FRAME];
         let c = hand.transform_point(&nalgebra::Vector3::new(0.0, 0.0, 0.095));
         let q = hand.quaternion_wxyz();

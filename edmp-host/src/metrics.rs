@@ -3,7 +3,7 @@
 //! diversity as ACSM (the mean cosine similarity over all pairs of a batch's trajectories,
 //! each flattened to one vector; lower is more diverse).
 
-use edmp_core::kinematics::Joints;
+use edmp_core::robot::kinematics::Joints;
 
 /// The paper's four roughness numbers of one trajectory (radians).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]

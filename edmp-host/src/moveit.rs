@@ -20,7 +20,7 @@
 use crate::Failure;
 use crate::json::{Problem, parse_problem};
 use core::fmt;
-use edmp_core::kinematics::forward;
+use edmp_core::robot::kinematics::forward;
 use edmp_core::robot::{FRAME_NAMES, HAND_FRAME, JOINT_NAMES, JOINTS, TCP_FRAME};
 use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
 use saphyr::{LoadableYamlNode, Scalar, Yaml};
@@ -536,7 +536,7 @@ fn tcp_offset(link: &str, path: &str) -> R<Isometry3<f64>> {
             )
         })?;
     let k = forward::<f64>(&[0.0; JOINTS]).map_err(|e| at(path, e.to_string()))?;
-    let iso = |p: &edmp_core::kinematics::Pose<f64>| {
+    let iso = |p: &edmp_core::robot::kinematics::Pose<f64>| {
         let r = Rotation3::from_matrix_unchecked(Matrix3::from(p.rotation));
         Isometry3::from_parts(
             Translation3::from(p.translation),

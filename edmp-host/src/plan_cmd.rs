@@ -7,18 +7,19 @@ use crate::Failure;
 use crate::json::{Problem, joint_goal, parse_problem};
 use crate::threads::Threads;
 use crate::timed::{TimedArgs, TimedRequest, trajectory_document};
+use edmp_core::cost::boxes::{BoxFrame, Inflation};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::executor::{Executor, Serial};
-use edmp_core::geometry::{BoxFrame, Inflation};
-use edmp_core::global::GlobalConfig;
-use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide, Schedule};
+use edmp_core::guidance::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide, Schedule};
+use edmp_core::path::HORIZON;
+use edmp_core::planner::global::GlobalConfig;
+use edmp_core::planner::search::SearchConfig;
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Judging, Plan,
     PlanConfig, RefineStop, Workspace, denoise_on, finish_on, polish, select,
 };
-use edmp_core::prior::{HORIZON, Sampler, Scratch};
+use edmp_core::prior::{Sampler, Scratch};
 use edmp_core::rng::Rng;
-use edmp_core::search::SearchConfig;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;

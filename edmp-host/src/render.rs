@@ -7,8 +7,8 @@
 //! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
 
 use crate::json::{Goal, parse_problem};
-use edmp_core::convex::{Convex, Primitive};
-use edmp_core::kinematics::{Joints, forward, forward_with};
+use edmp_core::collision::convex::{Convex, Primitive};
+use edmp_core::robot::kinematics::{Joints, forward, forward_with};
 use edmp_core::robot::{BODIES, PANDA};
 use edmp_core::scene::Shape;
 use nalgebra::Vector3;

@@ -2,17 +2,17 @@
 //! problems solvable, and the source of training trajectories.
 //!
 //! Bidirectional RRT (Kuffner & LaValle 2000) in joint space within the soft limits; every edge
-//! is validated by `edmp_core::checker` at the spec's 0.01 rad interpolation. The raw path is
+//! is validated by `edmp_core::collision::checker` at the spec's 0.01 rad interpolation. The raw path is
 //! shortcut (random pairs joined when the straight segment is free), resampled to `H`
 //! waypoints evenly by joint-space arc length, and smoothed (a few Laplacian passes, each kept
 //! only if the whole trajectory stays free). Deterministic for a seed.
 
 use core::time::Duration;
-use edmp_core::checker::{CheckConfig, check_end, check_segment, check_trajectory};
-use edmp_core::kinematics::Joints;
-use edmp_core::prior::HORIZON;
+use edmp_core::collision::checker::{CheckConfig, check_end, check_segment, check_trajectory};
+use edmp_core::path::HORIZON;
 use edmp_core::rng::Rng;
 use edmp_core::robot::PANDA;
+use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::Scene;
 use std::time::Instant;
 
@@ -262,7 +262,7 @@ pub(crate) fn plan<const H: usize, const N: usize>(
     if !free(&waypoints)? {
         // Even spacing cut a corner: keep every vertex of the shortcut path instead (the
         // core's resampling, for the core's horizon).
-        let through = edmp_core::search::resample_through_vertices(&path).filter(|_| H == HORIZON);
+        let through = edmp_core::planner::search::resample_through_vertices(&path).filter(|_| H == HORIZON);
         let Some(through) = through else {
             return Err(RrtError::Resample);
         };
@@ -351,7 +351,7 @@ mod tests {
         let scene = wall_scene();
         let inside = [0.0, 0.3, 0.0, -1.2, 0.0, 1.5, 0.785];
         assert!(
-            edmp_core::checker::check_state(&scene, &inside, &CheckConfig::default())
+            edmp_core::collision::checker::check_state(&scene, &inside, &CheckConfig::default())
                 .unwrap()
                 .is_some()
         );

@@ -9,8 +9,9 @@
 use crate::json::{Goal, parse_problem};
 use crate::metrics::{Roughness, roughness, step_norm};
 use crate::render::Canvas;
-use edmp_core::checker::{CheckConfig, check_trajectory};
-use edmp_core::prior::{HORIZON, Path, Sampler, Scratch, sample_conditioned};
+use edmp_core::collision::checker::{CheckConfig, check_trajectory};
+use edmp_core::path::{HORIZON, Path};
+use edmp_core::prior::{Sampler, Scratch, sample_conditioned};
 use edmp_core::rng::Rng;
 use edmp_core::robot::{JOINTS, PANDA};
 use edmp_core::scene::Scene;

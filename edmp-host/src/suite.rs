@@ -252,7 +252,7 @@ mod tests {
     /// seed (the very same JSON) and solved again by RRT-Connect: a sample, to keep CI short.
     #[test]
     fn every_unseen_problem_is_valid_and_a_sample_is_reproduced() {
-        use edmp_core::checker::{CheckConfig, check_state};
+        use edmp_core::collision::checker::{CheckConfig, check_state};
         use edmp_core::robot::PANDA;
         let mut count = 0;
         for family in Family::UNSEEN {

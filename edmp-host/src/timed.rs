@@ -7,8 +7,8 @@
 //! from rest to rest. Here it is sampled at the user's rate and written out.
 
 use crate::Failure;
-use edmp_core::checker::CheckConfig;
-use edmp_core::prior::Path;
+use edmp_core::collision::checker::CheckConfig;
+use edmp_core::path::Path;
 use edmp_core::scene::Scene;
 use edmp_core::trajectory::{Limits, Shape, Timed, parameterize_checked};
 use serde_json::{Value, json};

@@ -316,7 +316,7 @@ fn every_example_plans_a_collision_free_path_from_its_start_to_its_goal() {
         } else {
             pose_goals += 1;
             let pose = &doc["goal"]["pose"];
-            let tcp = *edmp_core::kinematics::forward::<f32>(&last).unwrap().tcp();
+            let tcp = *edmp_core::robot::kinematics::forward::<f32>(&last).unwrap().tcp();
             let p = &pose["position"];
             let error: f32 = (0..3)
                 .map(|i| (tcp.translation[i] - p[i].as_f64().unwrap() as f32).powi(2))
@@ -346,10 +346,10 @@ fn every_example_plans_a_collision_free_path_from_its_start_to_its_goal() {
             "{name}: outside the limits"
         );
         let trajectory: [[f32; 7]; 50] = core::array::from_fn(|i| waypoints[i]);
-        let report = edmp_core::checker::check_trajectory(
+        let report = edmp_core::collision::checker::check_trajectory(
             &scene_of(&doc),
             &trajectory,
-            &edmp_core::checker::CheckConfig::DEFAULT,
+            &edmp_core::collision::checker::CheckConfig::DEFAULT,
             false,
         )
         .unwrap();

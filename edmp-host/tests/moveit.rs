@@ -3,9 +3,9 @@
 //! trip of every example through MoveIt's format that plans to the same bits.
 
 use core::fmt::Write as _;
-use edmp_core::checker::{CheckConfig, check_trajectory};
-use edmp_core::kinematics::forward;
+use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::planner::PlanConfig;
+use edmp_core::robot::kinematics::forward;
 use edmp_host::json::{Goal, joint_goal, parse_problem};
 use edmp_host::moveit::{Source, import, import_validated};
 use edmp_host::plan_cmd::{chosen_guides, plan_problem};

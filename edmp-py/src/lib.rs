@@ -5,9 +5,9 @@
 //! its planner driver and its one writer of `edmp-plan/1` (`edmp_host::plan_cmd`), so a plan
 //! from Python is the CLI's document. Planning releases the GIL.
 
-use edmp_core::checker::{CheckConfig, Contact, check_trajectory};
+use edmp_core::collision::checker::{CheckConfig, Contact, check_trajectory};
+use edmp_core::path::HORIZON;
 use edmp_core::planner::{Judging, PlanConfig};
-use edmp_core::prior::HORIZON;
 use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS};
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;

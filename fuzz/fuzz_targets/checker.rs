@@ -10,8 +10,8 @@ mod common;
 
 use common::{Reader, finite, scene};
 use edmp_core::Error;
-use edmp_core::checker::{CheckConfig, MAX_STEPS_PER_SEGMENT, check_end, check_segment, check_state, check_trajectory};
-use edmp_core::kinematics::Joints;
+use edmp_core::collision::checker::{CheckConfig, MAX_STEPS_PER_SEGMENT, check_end, check_segment, check_state, check_trajectory};
+use edmp_core::robot::kinematics::Joints;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -5,9 +5,9 @@
 #![no_main]
 
 use edmp_core::Error;
-use edmp_core::checker::{CheckConfig, check_state, check_trajectory};
+use edmp_core::collision::checker::{CheckConfig, check_state, check_trajectory};
 use edmp_core::cost::{CostConfig, CostKind, CostMemo, trajectory_cost, trajectory_cost_memo};
-use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
+use edmp_core::cost::boxes::{BoxFrame, CylinderBox, Inflation};
 use edmp_core::scene::{Obstacle, Scene, SceneError};
 use libfuzzer_sys::fuzz_target;
 

@@ -6,7 +6,7 @@
 #![no_main]
 
 use edmp_core::Error;
-use edmp_core::kinematics::forward;
+use edmp_core::robot::kinematics::forward;
 use edmp_core::robot::JOINTS;
 use libfuzzer_sys::fuzz_target;
 

@@ -8,9 +8,9 @@
 mod common;
 
 use common::{Reader, finite, scene};
-use edmp_core::checker::{CheckConfig, check_end};
-use edmp_core::ik::{IkConfig, IkError, solve};
-use edmp_core::kinematics::Pose;
+use edmp_core::collision::checker::{CheckConfig, check_end};
+use edmp_core::robot::ik::{IkConfig, IkError, solve};
+use edmp_core::robot::kinematics::Pose;
 use edmp_core::robot::PANDA;
 use edmp_core::scene::rotation_from_wxyz;
 use libfuzzer_sys::fuzz_target;

@@ -5,16 +5,17 @@
 //! stop (`PlanConfig::refine_stop`) is fuzzed too, zero settings (typed errors) included.
 #![no_main]
 
-use edmp_core::checker::CheckConfig;
-use edmp_core::geometry::{BoxFrame, CylinderBox};
-use edmp_core::global::GlobalConfig;
-use edmp_core::guides::{CLEARANCE_GUIDE, EDMP_GUIDES};
+use edmp_core::collision::checker::CheckConfig;
+use edmp_core::cost::boxes::{BoxFrame, CylinderBox};
+use edmp_core::planner::global::GlobalConfig;
+use edmp_core::guidance::guides::{CLEARANCE_GUIDE, EDMP_GUIDES};
 use edmp_core::planner::{GuidanceSchedule, Judging, PlanConfig, RefineStop, Workspace, plan};
-use edmp_core::prior::{HORIZON, Sampler, Scratch};
+use edmp_core::prior::{Sampler, Scratch};
+use edmp_core::path::HORIZON;
 use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
-use edmp_core::search::SearchConfig;
-use edmp_core::shortcut::ShortcutConfig;
+use edmp_core::planner::search::SearchConfig;
+use edmp_core::planner::shortcut::ShortcutConfig;
 use libfuzzer_sys::fuzz_target;
 
 struct Reader<'a>(&'a [u8]);

@@ -11,11 +11,11 @@ mod common;
 
 use common::{Reader, finite, scene};
 use edmp_core::Error;
-use edmp_core::checker::{CheckConfig, check_segment};
-use edmp_core::kinematics::Joints;
-use edmp_core::prior::HORIZON;
+use edmp_core::collision::checker::{CheckConfig, check_segment};
+use edmp_core::robot::kinematics::Joints;
+use edmp_core::path::HORIZON;
 use edmp_core::rng::Rng;
-use edmp_core::search::{SearchConfig, SearchSpace, search};
+use edmp_core::planner::search::{SearchConfig, SearchSpace, search};
 use libfuzzer_sys::fuzz_target;
 
 const CAP: usize = 128;

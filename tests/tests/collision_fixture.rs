@@ -1,7 +1,7 @@
 //! The exact checker against PyBullet 3.2.7 (`tests/fixtures/collision_pybullet.json`):
 //! never "free" where PyBullet finds contact; the opposite error is measured and bounded.
 
-use edmp_core::checker::{
+use edmp_core::collision::checker::{
     CheckConfig, DEFAULT_MARGIN, END_MARGIN, PYBULLET_HULL_MARGIN, check_end, check_state, clearance,
 };
 use edmp_core::scene::{Obstacle, Scene};

@@ -8,9 +8,9 @@
 //! skipped and counted, and each case must keep most entries. Cases where some choice is won
 //! by less than 1e-5 m (below what f32 resolves reliably) are discarded as near a kink.
 
+use edmp_core::cost::boxes::{BoxFrame, CylinderBox, Inflation};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
-use edmp_core::geometry::{BoxFrame, CylinderBox, Inflation};
-use edmp_core::kinematics::{forward, forward_with};
+use edmp_core::robot::kinematics::{forward, forward_with};
 use edmp_core::robot::{BODIES, JOINTS, PANDA};
 use edmp_core::scene::{Obstacle, Scene};
 use edmp_tests::reference;
@@ -193,7 +193,7 @@ proptest! {
     fn identical_boxes_intersect_in_their_volume(lo in prop::array::uniform3(-2.0f32..2.0), size in prop::array::uniform3(0.001f32..1.0)) {
         let min = nalgebra::Vector3::from(lo);
         let max = min + nalgebra::Vector3::from(size);
-        let a = edmp_core::geometry::Aabb { min, max };
+        let a = edmp_core::cost::boxes::Aabb { min, max };
         let d = max - min;
         prop_assert_eq!(a.intersection_volume(&a), d.x * d.y * d.z);
     }

@@ -1,7 +1,7 @@
 //! Property tests: the hand-written adjoint against f64 central differences, and the TCP
 //! Jacobian against the adjoint.
 
-use edmp_core::kinematics::{CORNERS, Cotangent, forward};
+use edmp_core::robot::kinematics::{CORNERS, Cotangent, forward};
 use edmp_core::robot::{BODIES, JOINTS, PANDA, TCP_FRAME};
 use edmp_tests::{check_adjoint, finite_difference, gradient_scale, zero_gradient};
 use nalgebra::{Matrix3, Vector3};
@@ -12,7 +12,7 @@ fn joints_within_soft_limits() -> impl Strategy<Value = [f32; JOINTS]> {
     ranges.prop_map(|v| core::array::from_fn(|i| v[i]))
 }
 
-fn corner_gradient() -> impl Strategy<Value = edmp_core::kinematics::CornerGradient<f32>> {
+fn corner_gradient() -> impl Strategy<Value = edmp_core::robot::kinematics::CornerGradient<f32>> {
     proptest::collection::vec(-1.0f32..=1.0, BODIES * CORNERS * 3).prop_map(|v| {
         let mut g = zero_gradient();
         for (i, x) in v.into_iter().enumerate() {

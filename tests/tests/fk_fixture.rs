@@ -1,6 +1,6 @@
 //! FK against PyBullet 3.2.7 (`tests/fixtures/fk_pybullet.json`, 500 configurations).
 
-use edmp_core::kinematics::forward;
+use edmp_core::robot::kinematics::forward;
 use edmp_core::robot::{FRAME_NAMES, FRAMES};
 use edmp_tests::fk_fixture;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};

@@ -3,11 +3,11 @@
 //! configuration. Every solution must reproduce its pose within 1 mm / 0.5° and stay in the
 //! limits; the success rate is printed and bounded.
 
-use edmp_core::checker::{CheckConfig, check_state};
-use edmp_core::ik::{IkConfig, rotation_error, solve};
-use edmp_core::kinematics::forward;
+use edmp_core::collision::checker::{CheckConfig, check_state};
 use edmp_core::rng::Rng;
 use edmp_core::robot::PANDA;
+use edmp_core::robot::ik::{IkConfig, rotation_error, solve};
+use edmp_core::robot::kinematics::forward;
 use edmp_core::scene::Scene;
 
 #[test]

@@ -3,7 +3,8 @@
 //! golden value changes only when the committed weights or the network's arithmetic do (last:
 //! 2026-12-02, Mish's `e^x` as `expf(x/8)⁸`).
 
-use edmp_core::prior::{HORIZON, Path, Sampler, Scratch, sample};
+use edmp_core::path::{HORIZON, Path};
+use edmp_core::prior::{Sampler, Scratch, sample};
 use edmp_core::rng::Rng;
 
 /// Hashes of the run below with the committed weights (DDIM K = 10, strided K = 10, ancestral).

@@ -1,7 +1,8 @@
 //! The prior on arbitrary input: never a panic, never a NaN passed on as a result.
 
 use edmp_core::Error;
-use edmp_core::prior::{HORIZON, Path, Sampler, Scratch, TimeEmbedding, predict_noise, sample};
+use edmp_core::path::{HORIZON, Path};
+use edmp_core::prior::{Sampler, Scratch, TimeEmbedding, predict_noise, sample};
 use edmp_core::rng::Rng;
 use proptest::prelude::*;
 

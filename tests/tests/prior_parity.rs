@@ -4,7 +4,8 @@
 //! The fixture holds, per case, the fake-quantized model's ε (int8 weights × scale, float
 //! activations: the same arithmetic as `edmp-core`, in another order) and the float model's.
 
-use edmp_core::prior::{HORIZON, Path, Scratch, TimeEmbedding, predict_noise};
+use edmp_core::path::{HORIZON, Path};
+use edmp_core::prior::{Scratch, TimeEmbedding, predict_noise};
 use serde::Deserialize;
 
 /// Largest |rust − fake-quant| over a case, relative to the case's largest |ε|.

@@ -2,12 +2,12 @@
 //! (the planner bench's scene), a path found around it, and the 50-waypoint output checked
 //! free as a whole trajectory.
 
-use edmp_core::checker::{CheckConfig, check_state, check_trajectory};
-use edmp_core::kinematics::Joints;
-use edmp_core::prior::HORIZON;
+use edmp_core::collision::checker::{CheckConfig, check_state, check_trajectory};
+use edmp_core::path::HORIZON;
+use edmp_core::planner::search::{SearchConfig, SearchSpace, search};
 use edmp_core::rng::Rng;
+use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::{Obstacle, Scene};
-use edmp_core::search::{SearchConfig, SearchSpace, search};
 
 const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
 

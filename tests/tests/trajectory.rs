@@ -9,10 +9,10 @@
 //! `edmp-host plan --timed`.
 
 use edmp_core::Error;
-use edmp_core::checker::CheckConfig;
-use edmp_core::kinematics::Joints;
-use edmp_core::prior::HORIZON;
+use edmp_core::collision::checker::CheckConfig;
+use edmp_core::path::HORIZON;
 use edmp_core::rng::Rng;
+use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::{Obstacle, Scene};
 use edmp_core::trajectory::limits::{ACCELERATION, JERK, VELOCITY};
 use edmp_core::trajectory::{

@@ -3,7 +3,7 @@
 //! Geometry is exact, never boxed: each robot body is the convex hull of its collision mesh
 //! (the same hull PyBullet collides), obstacles and the held object are true cuboids,
 //! cylinders and spheres. A pair is declared free only when a GJK separating direction
-//! *certifies* a gap larger than the margin ([`crate::gjk::apart`]); anything else counts as
+//! *certifies* a gap larger than the margin ([`crate::collision::gjk::apart`]); anything else counts as
 //! contact. Cheap tests run first and can only prove freedom: bounding balls, then the body's
 //! oriented box (which holds its hull).
 //!
@@ -12,11 +12,11 @@
 //! neighbours (link7, hand, fingers and held object form one rigid group), at every waypoint
 //! and at every state of the linear joint interpolation in steps of at most `max_step`.
 
-use crate::convex::{Hull, Primitive};
+use crate::collision::convex::{Hull, Primitive};
+use crate::collision::gjk::{apart_by, distance_lower_bound};
 use crate::error::Error;
-use crate::gjk::{apart_by, distance_lower_bound};
-use crate::kinematics::{Joints, Kinematics, forward_with};
-use crate::reach::{BODY_REACH, HAND_REACH, motion};
+use crate::robot::kinematics::{Joints, Kinematics, forward_with};
+use crate::robot::reach::{BODY_REACH, HAND_REACH, motion};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Scene, Shape};
 use core::cmp::Ordering;
@@ -255,7 +255,7 @@ const PAIRS: usize = SLOTS * SLOTS;
 
 /// How far two shapes can move relative to each other for joint steps `step`: a joint that
 /// turns both turns them together and changes nothing between them; one that turns only one
-/// moves it by its reach ([`crate::reach`]).
+/// moves it by its reach ([`crate::robot::reach`]).
 fn relative_motion(a: &[f32; JOINTS], b: &[f32; JOINTS], step: &Joints<f32>) -> f32 {
     let mut m = 0.0f32;
     for ((ra, rb), d) in a.iter().zip(b).zip(step) {
@@ -284,7 +284,7 @@ fn sqrt_below(x: f32) -> f32 {
 /// the kinematics' f32 rounding (metres).
 const CARRY_SLACK: f32 = 1e-4;
 
-/// Clearance carried from one state to the next ([`crate::reach`]): per pair, how far its
+/// Clearance carried from one state to the next ([`crate::robot::reach`]): per pair, how far its
 /// shapes may still move, together, before the gap last certified for it no longer proves the
 /// margin. A pair with slack left at a state is free there without a test, and a state all of
 /// whose pairs have slack left needs no kinematics.
@@ -377,7 +377,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
     /// here without a test; the others are tested, and a pair proven apart carries its new gap
     /// less the largest margin a state may need (`margin` or `end_margin`). Every "free" is
     /// still certified: by a separating direction at this state, or at an earlier one whose
-    /// gap the motion since (bounded by [`crate::reach`]) cannot have used up.
+    /// gap the motion since (bounded by [`crate::robot::reach`]) cannot have used up.
     fn contact_at(&mut self, q: &Joints<f32>, margin: f32) -> Result<Option<Contact>, Error> {
         let count = self.scene.obstacles().len();
         let step: Joints<f32> = match &self.slack.at {
@@ -716,7 +716,7 @@ fn interpolate(a: &Joints<f32>, b: &Joints<f32>, step: u32, steps: u32) -> Joint
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kinematics::forward;
+    use crate::robot::kinematics::forward;
     use crate::scene::Obstacle;
 
     const READY: [f32; 7] = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];

@@ -4,7 +4,7 @@
 //! Every shape here is exact: a robot body is the convex hull of its collision-mesh vertices
 //! (what PyBullet uses too), obstacles are true cuboids, spheres and cylinders.
 
-use crate::kinematics::Pose;
+use crate::robot::kinematics::Pose;
 use crate::scene::{Obstacle, Shape};
 use nalgebra::{Matrix3, Vector3};
 

@@ -7,7 +7,7 @@
 //! when a separating direction proves it. A GJK that stalls or hits its iteration cap can make
 //! the checker call a free pair colliding, never the other way round.
 
-use crate::convex::Convex;
+use crate::collision::convex::Convex;
 use nalgebra::Vector3;
 
 /// Iteration cap of [`closest`]; well above what polytopes of a few hundred vertices need.
@@ -357,7 +357,7 @@ fn nearest_on_tetrahedron(s: &Simplex) -> (V, Kept) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::convex::Primitive;
+    use crate::collision::convex::Primitive;
     use crate::scene::Obstacle;
 
     const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];

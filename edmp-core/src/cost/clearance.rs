@@ -25,13 +25,13 @@
 //! Work: one FK per waypoint; per (body, segment, obstacle) whose bounding balls come within `c`,
 //! a GJK on the body's two oriented boxes (which hold its hulls), and only where those come within
 //! `c` a GJK on the hulls. A guide with this cost is data like any other
-//! ([`crate::guides::CLEARANCE_GUIDE`]).
+//! ([`crate::guidance::guides::CLEARANCE_GUIDE`]).
 
-use crate::checker::moves;
-use crate::convex::{Convex, Hull, Primitive};
+use crate::collision::checker::moves;
+use crate::collision::convex::{Convex, Hull, Primitive};
+use crate::collision::gjk::{closest, gap_along};
 use crate::error::Error;
-use crate::gjk::{closest, gap_along};
-use crate::kinematics::{Cotangent, Joints, Kinematics, forward_with};
+use crate::robot::kinematics::{Cotangent, Joints, Kinematics, forward_with};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::Scene;
 use nalgebra::Vector3;
@@ -58,7 +58,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     }
     let obstacles: [Primitive; N] = core::array::from_fn(|i| {
         scene.obstacles().get(i).map_or(
-            Primitive::cuboid(&crate::kinematics::Pose::identity(), &Vector3::zeros()),
+            Primitive::cuboid(&crate::robot::kinematics::Pose::identity(), &Vector3::zeros()),
             Primitive::obstacle,
         )
     });

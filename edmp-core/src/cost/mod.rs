@@ -17,9 +17,12 @@
 //! through [`Kinematics::joint_gradient`]. Waypoints whose boxes touch nothing get an exact
 //! zero without running the adjoint.
 
+pub mod boxes;
+pub mod clearance;
+
+use crate::cost::boxes::{Aabb, BoxFrame, CylinderBox, Inflation, box_dims, inflated_dims, obstacle_aabb};
 use crate::error::Error;
-use crate::geometry::{Aabb, BoxFrame, CylinderBox, Inflation, box_dims, inflated_dims, obstacle_aabb};
-use crate::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward_into};
+use crate::robot::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward_into};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Obstacle, Scene};
 use nalgebra::{Matrix3, Vector3};
@@ -32,7 +35,7 @@ pub enum CostKind {
     /// Swept volume over segments ("sv").
     Swept,
     /// The exact clearance of the checker's hulls from the true obstacles over the segments,
-    /// within the inflation's clearance ([`crate::clearance`]; not EDMP's: an
+    /// within the inflation's clearance ([`crate::cost::clearance`]; not EDMP's: an
     /// ablation of the stronger local optimizer). Expansion, cylinder boxes and frame do not
     /// apply.
     Clearance,
@@ -398,7 +401,7 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
         return Err(Error::BadParameter);
     }
     if config.kind == CostKind::Clearance {
-        return crate::clearance::trajectory_cost(scene, trajectory, clearance, gradient);
+        return crate::cost::clearance::trajectory_cost(scene, trajectory, clearance, gradient);
     }
     // Refuse bad input before any work, so the error names it whatever comes later.
     for q in trajectory {
@@ -730,7 +733,7 @@ fn waypoint_gradient(w: &Waypoint) -> Result<Joints<f32>, Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kinematics::forward;
+    use crate::robot::kinematics::forward;
     use crate::scene::Obstacle;
 
     const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];

@@ -4,7 +4,7 @@
 //! guides 1-5, 10, 11, 13, 14, 16, 18, 21); the planner reads it, it holds no code.
 
 use crate::cost::CostKind;
-use crate::geometry::Inflation;
+use crate::cost::boxes::Inflation;
 
 /// A value that depends on the diffusion step. `i = t − 1` (0 ..= 254), as the original indexes
 /// its per-step tables.

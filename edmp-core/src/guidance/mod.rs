@@ -8,12 +8,14 @@
 //! limit per joint keeps the unnormalized guides (whose step is the raw gradient times ~2)
 //! from throwing a waypoint across the workspace where the costs are steep.
 
+pub mod guides;
+
+use crate::cost::boxes::{BoxFrame, CylinderBox};
 use crate::cost::{CostConfig, CostMemo, trajectory_cost_memo};
 use crate::error::Error;
 use crate::executor::{Executor, MAX_PARTS, split};
-use crate::geometry::{BoxFrame, CylinderBox};
-use crate::guides::Guide;
-use crate::kinematics::Joints;
+use crate::guidance::guides::Guide;
+use crate::robot::kinematics::Joints;
 use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
 
@@ -326,7 +328,7 @@ pub fn bending_gradient<const H: usize>(row: &[Joints<f32>; H]) -> [Joints<f32>;
 mod tests {
     use super::*;
     use crate::cost::{CostKind, trajectory_cost};
-    use crate::guides::EDMP_GUIDES;
+    use crate::guidance::guides::EDMP_GUIDES;
     use crate::scene::Obstacle;
 
     const H: usize = 12;
@@ -370,7 +372,7 @@ mod tests {
             let mut grads = [[[0.0; 7]; H]];
             // Small steps: the same direction, scaled down so the first-order decrease shows.
             let small = Guide {
-                step: crate::guides::Schedule::Constant(1e-3),
+                step: crate::guidance::guides::Schedule::Constant(1e-3),
                 ..*guide
             };
             guide_step(
@@ -483,10 +485,10 @@ mod tests {
         let guide = Guide {
             id: 0,
             cost: CostKind::Swept,
-            clearance: crate::guides::Schedule::Constant(0.0),
-            expansion: crate::guides::Schedule::Constant(0.0),
+            clearance: crate::guidance::guides::Schedule::Constant(0.0),
+            expansion: crate::guidance::guides::Schedule::Constant(0.0),
             normalize: true,
-            step: crate::guides::Schedule::Constant(0.01),
+            step: crate::guidance::guides::Schedule::Constant(0.01),
             smooth: 0.0,
         };
         let a = [-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8];

@@ -2,7 +2,7 @@
 //!
 //! Local guidance cannot leave the basin the prior's sample fell into: a cage's slot, a box's
 //! window or a shelf's pocket may need a detour that no gradient points to. Then
-//! 1. [`crate::search`] (RRT-Connect over the exact checker, fixed capacity, bounded
+//! 1. [`crate::planner::search`] (RRT-Connect over the exact checker, fixed capacity, bounded
 //!    iterations) finds a collision-free coarse path;
 //! 2. the prior makes trajectories of its own from it, SDEdit-style: each row gets the path
 //!    noised to an intermediate diffusion step ([`prior::diffuse`]) and is denoised from there
@@ -17,18 +17,19 @@
 //! once, when no wave frees one), and one more selection.
 //! [`Plan::stage`] says which stage produced the winner.
 
-use crate::checker::check_segment;
+use crate::collision::checker::check_segment;
 use crate::error::Error;
 use crate::executor::Executor;
-use crate::guides::Guide;
-use crate::kinematics::Joints;
+use crate::guidance::guides::Guide;
+use crate::path::Path;
+use crate::planner::search::{SearchConfig, search_from};
 use crate::planner::{
     Plan, PlanConfig, RowChecks, Workspace, guide_steps, in_waves, judge, rank_in_full, refine, select,
 };
-use crate::prior::{self, Path, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise_on};
+use crate::prior::{self, STEPS, Sampler, Scratch, Step, TimeEmbedding, predict_noise_on};
 use crate::rng::Rng;
+use crate::robot::kinematics::Joints;
 use crate::scene::Scene;
-use crate::search::{SearchConfig, search_from};
 
 /// Settings of the global stage.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,32 +2,37 @@
 //! step let every row follow its guide, then judge every candidate with the exact checker and
 //! keep the free one with the lowest swept volume.
 //!
-//! When no candidate is free, the bounded global stage ([`crate::global`]) searches for a
+//! When no candidate is free, the bounded global stage ([`crate::planner::global`]) searches for a
 //! path and hands it back to the prior.
 //!
 //! Fixed work: the number of network forwards and cost gradients is set by the sampler, the
 //! guidance schedule and `B`, never by the scene's luck; the checker's states are bounded by
 //! the path length (at most `MAX_STEPS_PER_SEGMENT` per segment, each candidate checked at
 //! most twice: once to its first contact, once in full when no candidate is free). The global
-//! stage adds a bounded amount on top ([`crate::global`] states it).
+//! stage adds a bounded amount on top ([`crate::planner::global`] states it).
 
-use crate::checker::{CheckConfig, check_trajectory, check_trajectory_from};
+pub mod global;
+pub mod search;
+pub mod shortcut;
+
+use crate::collision::checker::{CheckConfig, check_trajectory, check_trajectory_from};
+use crate::cost::boxes::{BoxFrame, CylinderBox, Inflation};
 use crate::cost::{CostConfig, CostKind, CostMemo, trajectory_cost};
 use crate::error::Error;
 use crate::executor::{Executor, Serial};
-use crate::geometry::{BoxFrame, CylinderBox, Inflation};
-use crate::global::{GlobalConfig, SearchReport, Stage, rescue};
+use crate::guidance::guides::Guide;
 use crate::guidance::{StepControl, StepRule, guide_step_controlled, guide_step_on};
-use crate::guides::Guide;
-use crate::kinematics::Joints;
+use crate::path::{HORIZON, Path};
+use crate::planner::global::{GlobalConfig, SearchReport, Stage, rescue};
+use crate::planner::search::SearchSpace;
+use crate::planner::shortcut::{ShortcutConfig, ShortcutReport, shorten};
 use crate::prior::{
-    HORIZON, Path, Sampler, Scratch, TimeEmbedding, check_joints, free_ends, initial_noise, inpaint, predict_noise_on,
+    Sampler, Scratch, TimeEmbedding, check_joints, free_ends, initial_noise, inpaint, predict_noise_on,
 };
 use crate::rng::Rng;
+use crate::robot::kinematics::Joints;
 use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
-use crate::search::SearchSpace;
-use crate::shortcut::{ShortcutConfig, ShortcutReport, shorten};
 
 /// When guidance runs and how often.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -87,14 +92,14 @@ pub struct PlanConfig {
     pub check: CheckConfig,
     /// The global stage when no candidate is free (`None`: EDMP alone, as the paper).
     pub global: Option<GlobalConfig>,
-    /// Shortening of the free winner over the exact checker ([`crate::shortcut`]; `None`: the
+    /// Shortening of the free winner over the exact checker ([`crate::planner::shortcut`]; `None`: the
     /// winner as the guides left it, as the paper).
     pub shortcut: Option<ShortcutConfig>,
     /// Ending the refinement early on the exact checker's word ([`RefineStop`]; `None`: every
     /// refinement step runs, as in EDMP's fixed schedule).
     pub refine_stop: Option<RefineStop>,
     /// The guide every row follows in the refinement (`None`: each row its own, as EDMP; e.g.
-    /// [`crate::guides::CLEARANCE_GUIDE`], the exact-clearance ablation, docs/benchmark.md).
+    /// [`crate::guidance::guides::CLEARANCE_GUIDE`], the exact-clearance ablation, docs/benchmark.md).
     pub refine_guide: Option<Guide>,
     /// Step-size control in the refinement ([`StepControl`]: a step that raised a guide's cost
     /// is undone and its step halves; `false`: EDMP's fixed steps). An ablation.
@@ -435,7 +440,7 @@ pub fn plan_on<E: Executor, const B: usize, const N: usize, const C: usize, cons
 }
 
 /// After [`select`]: a plan with a free candidate is done; otherwise the global stage runs
-/// when `config.global` asks for it ([`crate::global::rescue`]), in place.
+/// when `config.global` asks for it ([`crate::planner::global::rescue`]), in place.
 #[allow(clippy::too_many_arguments)]
 pub fn finish<const B: usize, const N: usize, const C: usize, const CAP: usize>(
     scene: &Scene<N>,
@@ -477,7 +482,7 @@ pub fn finish_on<E: Executor, const B: usize, const N: usize, const C: usize, co
 }
 
 /// After [`finish`]: a free winner is shortened over the exact checker when `config.shortcut`
-/// asks for it ([`crate::shortcut::shorten`]), in place; its swept volume is recomputed.
+/// asks for it ([`crate::planner::shortcut::shorten`]), in place; its swept volume is recomputed.
 pub fn polish<const B: usize, const N: usize>(
     scene: &Scene<N>,
     start: &Joints<f32>,
@@ -792,7 +797,7 @@ pub(crate) type WaveChecks<'a> = (&'a mut [bool], &'a mut [Option<u16>]);
 /// runs, and the first wave with a free row ends it. The rows of waves not run are
 /// `RowChecks::skipped` in `work.checks` (never judged), and every row is put back in the
 /// caller's order (row r follows guide r / k whatever the waves). Shared by the first stage
-/// ([`denoise_on`]) and the global stage's reseeding ([`crate::global`]).
+/// ([`denoise_on`]) and the global stage's reseeding ([`crate::planner::global`]).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: usize>(
     exec: &E,
@@ -1105,9 +1110,9 @@ pub fn rank_in_full<const B: usize, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::guides::EDMP_GUIDES;
+    use crate::guidance::guides::EDMP_GUIDES;
+    use crate::planner::search::SearchConfig;
     use crate::scene::Obstacle;
-    use crate::search::SearchConfig;
     use std::boxed::Box;
 
     fn wall_scene() -> Scene<4> {

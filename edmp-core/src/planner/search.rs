@@ -29,9 +29,9 @@
 )]
 
 use crate::error::Error;
-use crate::kinematics::Joints;
-use crate::prior::{HORIZON, Path};
+use crate::path::{HORIZON, Path};
 use crate::rng::Rng;
+use crate::robot::kinematics::Joints;
 use crate::robot::{JOINTS, PANDA};
 use core::fmt;
 
@@ -637,7 +637,7 @@ where
 }
 
 /// `HORIZON` points evenly spaced by joint-space arc length along `path` (ends exact). Public
-/// for the shortening of the chosen path ([`crate::shortcut`]).
+/// for the shortening of the chosen path ([`crate::planner::shortcut`]).
 pub fn resample_even(path: &[Joints<f32>]) -> Path {
     let first = path.first().copied().unwrap_or_default();
     let last = path.last().copied().unwrap_or(first);

@@ -24,13 +24,13 @@
     clippy::arithmetic_side_effects
 )]
 
-use crate::checker::{CheckConfig, check_segment, check_trajectory};
+use crate::collision::checker::{CheckConfig, check_segment, check_trajectory};
 use crate::error::Error;
-use crate::kinematics::Joints;
-use crate::prior::{HORIZON, Path};
+use crate::path::{HORIZON, Path};
+use crate::planner::search::{resample_even, resample_through_vertices, segment_length, shortcut_polyline};
 use crate::rng::Rng;
+use crate::robot::kinematics::Joints;
 use crate::scene::Scene;
-use crate::search::{resample_even, resample_through_vertices, segment_length, shortcut_polyline};
 
 /// How hard [`shorten`] tries.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -22,23 +22,19 @@ mod generated {
 }
 
 pub use generated::{DIMS, LENGTHS, LEVELS, MACS, PARAMETERS, STEPS, WEIGHT_BYTES, WEIGHTS_FNV1A};
-pub use net::{Scratch, TimeEmbedding, Trajectory, predict_noise, predict_noise_on};
+pub use net::{Scratch, TimeEmbedding, predict_noise, predict_noise_on};
 
 use crate::Error;
+use crate::path::{HORIZON, Path};
 use crate::rng::Rng;
 use crate::robot::JOINTS;
 
-/// Waypoints of a trajectory the prior makes.
-pub const HORIZON: usize = LENGTHS[0];
-
-// The network must have been trained on this robot's joints.
+// The network must have been trained on this robot's joints and the planner's horizon.
 const _: () = assert!(
     generated::JOINTS == JOINTS,
     "weights/prior was trained for another joint count"
 );
-
-/// A trajectory of the prior's horizon.
-pub type Path = Trajectory<HORIZON>;
+const _: () = assert!(LENGTHS[0] == HORIZON, "weights/prior was trained for another horizon");
 
 /// The weight blob the build embedded: `include_bytes!` of the codegen output.
 pub fn weight_blob() -> &'static [u8] {

@@ -14,6 +14,7 @@
 use super::generated::{DIMS, GROUPS, KERNEL, LENGTHS, LEVELS, NET, TIME_DIM, TIME_HIDDEN, TOP_SKIP};
 use crate::Error;
 use crate::executor::{Executor, MAX_PARTS, split};
+use crate::path::Trajectory;
 use crate::robot::JOINTS;
 
 /// Zero columns on each side of an activation row.
@@ -166,9 +167,6 @@ pub(crate) struct Net {
     pub(crate) final_block: ConvBlock,
     pub(crate) out: Conv,
 }
-
-/// One trajectory, waypoint-major, raw joint angles in radians.
-pub type Trajectory<const H: usize> = [[f32; JOINTS]; H];
 
 /// Mish of the time embedding of step `t`: what every residual block projects.
 /// Depends on `t` alone, so a batch computes it once per step.

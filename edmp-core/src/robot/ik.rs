@@ -11,9 +11,9 @@
 //! opening). Of the solutions found, the one
 //! nearest the preferred configuration (Euclidean, joint space) wins.
 
-use crate::checker::{CheckConfig, END_MARGIN, check_end};
+use crate::collision::checker::{CheckConfig, END_MARGIN, check_end};
 use crate::error::Error;
-use crate::kinematics::{Joints, Pose, forward};
+use crate::robot::kinematics::{Joints, Pose, forward};
 use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
 use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3, Vector6};

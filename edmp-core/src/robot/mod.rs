@@ -1,11 +1,15 @@
 //! The Panda as frozen by `edmp-codegen` at build time: link frames, collision boxes, limits.
 //! The one input the tables leave open is the gripper opening: each finger frame is its fixed
 //! transform at opening 0 plus [`FrameSpec::slide`] times the opening (see
-//! [`crate::kinematics::forward_with`]).
+//! [`crate::robot::kinematics::forward_with`]).
 //!
 //! No number of the robot is typed here: the tables come from `OUT_DIR/panda.rs`, which the
 //! build script generates from `weights/panda/panda.urdf` and its collision meshes. Read the
 //! generated file (or run `cargo run -p edmp-codegen`) to see each number and its origin.
+
+pub mod ik;
+pub mod kinematics;
+pub mod reach;
 
 use nalgebra::{Matrix3, RealField, Vector3};
 
@@ -83,7 +87,7 @@ include!(concat!(env!("OUT_DIR"), "/panda.rs"));
 // URDF numbers such as the hardware limit -3.1416 are data, not approximations of π.
 pub static PANDA: Robot<f32> = PANDA_TABLES;
 /// The same tables as a constant, for tables derived from them at compile time
-/// ([`crate::reach`]; a `static` cannot be read there).
+/// ([`crate::robot::reach`]; a `static` cannot be read there).
 #[allow(clippy::excessive_precision, clippy::approx_constant)]
 pub(crate) const PANDA_TABLES: Robot<f32> = panda_tables!();
 /// The Panda in `f64`: for oracles (finite differences) and host-side tools.

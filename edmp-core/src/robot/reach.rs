@@ -1,6 +1,6 @@
 //! How far a joint step can move any point of a robot body, whatever the configuration: the
 //! bound that lets the exact checker carry a certified clearance from one state to the next
-//! instead of proving it again ([`crate::checker`]).
+//! instead of proving it again ([`crate::collision::checker`]).
 //!
 //! A point of a body turns about joint `j`'s axis at a distance of at most the lengths of the
 //! frame offsets from joint `j`'s frame down to the body's frame plus the body's farthest hull
@@ -125,9 +125,9 @@ const fn body_reach() -> [[f32; JOINTS]; BODIES] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kinematics::forward;
     use crate::rng::Rng;
     use crate::robot::PANDA;
+    use crate::robot::kinematics::forward;
 
     #[test]
     fn no_hull_point_moves_farther_than_the_bound() {

@@ -1,9 +1,9 @@
 //! The exact checker along the curve itself, not only along the waypoints' polyline.
 
 use super::spline::{Curve, Shape, deviation_bound, validate_waypoints};
-use crate::checker::{CheckConfig, MAX_STEPS_PER_SEGMENT, check_segment};
+use crate::collision::checker::{CheckConfig, MAX_STEPS_PER_SEGMENT, check_segment};
 use crate::error::Error;
-use crate::kinematics::Joints;
+use crate::robot::kinematics::Joints;
 use crate::scene::Scene;
 
 /// Fraction of the checker's step the curve's samples keep to, so that `f32` rounding of the

@@ -1,7 +1,7 @@
 //! Franka's joint limits and the user's scales on them.
 
 use crate::error::Error;
-use crate::kinematics::Joints;
+use crate::robot::kinematics::Joints;
 
 /// Largest joint velocity (rad/s), Franka's datasheet: joints 1-4, then 5-7.
 pub const VELOCITY: Joints<f32> = [2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61];

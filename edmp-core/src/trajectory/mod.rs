@@ -38,11 +38,11 @@ pub use check::{CurveReport, check_curve};
 pub use limits::{JointLimits, Limits};
 pub use spline::{Curve, Shape, deviation_bound};
 
-use crate::checker::CheckConfig;
+use crate::collision::checker::CheckConfig;
 use crate::error::Error;
-use crate::kinematics::Joints;
-use crate::prior::HORIZON;
+use crate::path::HORIZON;
 use crate::robot::JOINTS;
+use crate::robot::kinematics::Joints;
 use crate::scene::Scene;
 use profile::{Law, Profile};
 

@@ -10,8 +10,8 @@
 //! The parameter `u` runs over `[0, spans]`, one unit per span; derivatives are per unit of `u`.
 
 use crate::error::Error;
-use crate::kinematics::Joints;
 use crate::robot::JOINTS;
+use crate::robot::kinematics::Joints;
 
 /// Largest magnitude (rad) of a waypoint joint the timing accepts: far beyond any Panda joint,
 /// small enough that every difference and product of the timing stays finite in `f32`.

@@ -284,7 +284,7 @@ mod tests {
     use super::super::limits::Limits;
     use super::super::spline::Shape;
     use super::*;
-    use crate::kinematics::Joints;
+    use crate::robot::kinematics::Joints;
 
     #[test]
     fn profile_starts_and_ends_at_rest_within_limits_at_the_grid() {

@@ -17,11 +17,11 @@ mod tabletop;
 mod under_table;
 mod window_box;
 
-use edmp_core::checker::{CheckConfig, check_state};
-use edmp_core::ik::{IkConfig, solve};
-use edmp_core::kinematics::{Joints, Pose};
+use edmp_core::collision::checker::{CheckConfig, check_state};
 use edmp_core::rng::Rng;
 use edmp_core::robot::PANDA;
+use edmp_core::robot::ik::{IkConfig, solve};
+use edmp_core::robot::kinematics::{Joints, Pose};
 use edmp_core::scene::{MAX_OBSTACLES, Obstacle, Scene};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use serde_json::{Value, json};
@@ -406,13 +406,13 @@ pub(crate) fn reach(
     let ik = IkConfig {
         starts: 16,
         max_solutions: 1,
-        clearance: edmp_core::checker::DEFAULT_MARGIN,
+        clearance: edmp_core::collision::checker::DEFAULT_MARGIN,
         ..IkConfig::default()
     };
     for _ in 0..attempts {
         let pose = region.sample(rng);
         if let Ok(s) = solve(&pose, &NEUTRAL, scene, &ik) {
-            let reached = *edmp_core::kinematics::forward(&s.joints).ok()?.tcp();
+            let reached = *edmp_core::robot::kinematics::forward(&s.joints).ok()?.tcp();
             return Some((s.joints, reached));
         }
     }
@@ -463,7 +463,7 @@ pub(crate) fn problem(family: Family, kind: Kind, seed: u64) -> Option<Problem> 
         Kind::NeutralGoal => {
             let (s, _) = reach(&scene, &env.regions[first], &mut rng, 20)?;
             let g = neutral(&scene, &mut rng)?;
-            let pose = *edmp_core::kinematics::forward(&g).ok()?.tcp();
+            let pose = *edmp_core::robot::kinematics::forward(&g).ok()?.tcp();
             (s, g, pose)
         }
     };
@@ -507,7 +507,7 @@ fn targeted(
         Kind::NeutralGoal => {
             let (s, _) = reach(&scene, &target, rng, 20)?;
             let g = neutral(&scene, rng)?;
-            let pose = *edmp_core::kinematics::forward(&g).ok()?.tcp();
+            let pose = *edmp_core::robot::kinematics::forward(&g).ok()?.tcp();
             (s, g, pose)
         }
     };
