@@ -10,7 +10,7 @@ use edmp_core::cost::boxes::{BoxFrame, CylinderBox, Inflation};
 use edmp_core::cost::{CostConfig, CostKind, CostMemo, trajectory_cost};
 use edmp_core::executor::Serial;
 use edmp_core::guidance::guides::EDMP_GUIDES;
-use edmp_core::guidance::{StepRule, guide_step_on};
+use edmp_core::guidance::{GuideStep, StepRule, guide_step_on};
 use edmp_core::rng::Rng;
 use edmp_core::robot::HAND_FRAME;
 use edmp_core::robot::kinematics::forward;
@@ -131,9 +131,11 @@ fn bench(c: &mut Criterion) {
                 scene,
                 &mut rows,
                 &mut grads,
-                &EDMP_GUIDES,
-                t,
-                &rule,
+                &GuideStep {
+                    guides: &EDMP_GUIDES,
+                    t,
+                    rule,
+                },
                 &mut settled,
                 memos,
             )

@@ -3,7 +3,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use edmp_core::guidance::guides::EDMP_GUIDES;
-use edmp_core::planner::{GuidanceSchedule, PlanConfig, Workspace, plan};
+use edmp_core::planner::{GuidanceSchedule, PlanConfig, Request, Workspace, plan};
 use edmp_core::prior::{Sampler, Scratch};
 use edmp_core::rng::Rng;
 use edmp_core::scene::{Obstacle, Scene};
@@ -55,11 +55,13 @@ fn bench(c: &mut Criterion) {
         group.bench_function(format!("wall, 12 guides, {label}"), |b| {
             b.iter(|| {
                 plan(
-                    &scene,
-                    &start,
-                    &goal,
-                    &EDMP_GUIDES,
-                    &config,
+                    &Request {
+                        scene: &scene,
+                        start: &start,
+                        goal: &goal,
+                        guides: &EDMP_GUIDES,
+                        config: &config,
+                    },
                     &mut Rng::new(1),
                     &mut scratch,
                     &mut work,

@@ -13,7 +13,7 @@ use crate::plan_cmd::{Tuning, chosen_guides, plan_problem_on};
 use crate::plots;
 use core::time::Duration;
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
-use edmp_core::planner::global::Stage;
+use edmp_core::planner::Stage;
 use edmp_core::robot::kinematics::Joints;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;

@@ -12,7 +12,7 @@ use crate::Failure;
 use crate::json::{joint_goal, parse_problem};
 use core::fmt::Write as _;
 use edmp_core::guidance::guides::EDMP_GUIDES;
-use edmp_core::planner::{Plan, PlanConfig, Workspace, plan};
+use edmp_core::planner::{Plan, PlanConfig, Request, Workspace, plan};
 use edmp_core::prior::Scratch;
 use edmp_core::rng::Rng;
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
@@ -131,11 +131,13 @@ pub fn plan_like_firmware(problem: &Problem<MAX_OBSTACLES>) -> Result<Plan<ROWS>
     let mut work = Box::new(Workspace::<ROWS>::new());
     let mut rng = Rng::new(problem.seed);
     plan::<ROWS, MAX_OBSTACLES, 4, { edmp_core::planner::DEFAULT_SEARCH_NODES }>(
-        &scene,
-        &problem.start,
-        &problem.goal,
-        &EDMP_GUIDES,
-        &PlanConfig::DEFAULT,
+        &Request {
+            scene: &scene,
+            start: &problem.start,
+            goal: &problem.goal,
+            guides: &EDMP_GUIDES,
+            config: &PlanConfig::DEFAULT,
+        },
         &mut rng,
         &mut scratch,
         &mut work,

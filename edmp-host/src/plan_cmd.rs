@@ -11,12 +11,11 @@ use edmp_core::cost::boxes::{BoxFrame, Inflation};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::executor::{Executor, Serial};
 use edmp_core::guidance::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide, Schedule};
-use edmp_core::path::HORIZON;
-use edmp_core::planner::global::GlobalConfig;
+use edmp_core::planner::GlobalConfig;
 use edmp_core::planner::search::SearchConfig;
 use edmp_core::planner::{
-    DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Judging, Plan,
-    PlanConfig, RefineStop, Workspace, denoise_on, finish_on, polish, select,
+    DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Judging,
+    Observer, Phase, Plan, PlanConfig, RefineStop, Request, Workspace, plan_observed,
 };
 use edmp_core::prior::{Sampler, Scratch};
 use edmp_core::rng::Rng;
@@ -447,46 +446,17 @@ fn plan_with<E: Executor, const C: usize>(
     let goal = joint_goal(problem).map_err(Failure::Input)?;
     let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
     let mut work = Box::new(Workspace::<ROWS, HOST_SEARCH_NODES>::new());
-    let mut paths = Box::new([[[0.0f32; 7]; HORIZON]; ROWS]);
-    let mut rng = Rng::new(seed);
-    let denoise_began = Instant::now();
-    denoise_on(
-        exec,
-        &problem.scene,
-        &problem.start,
-        &goal,
+    let req = Request {
+        scene: &problem.scene,
+        start: &problem.start,
+        goal: &goal,
         guides,
         config,
-        &mut rng,
-        scratches,
-        &mut work,
-        &mut paths,
-    )
-    .map_err(|e| Failure::Input(format!("planner: {e}")))?;
-    let denoise_ms = denoise_began.elapsed().as_secs_f64() * 1e3;
-    let select_began = Instant::now();
-    let mut plan = select(&problem.scene, &problem.start, &goal, config, *paths, &work.checks)
+    };
+    let mut stopwatch = Stopwatch::default();
+    let plan = plan_observed(exec, &req, &mut Rng::new(seed), scratches, &mut work, &mut stopwatch)
         .map_err(|e| Failure::Input(format!("planner: {e}")))?;
-    let select_ms = select_began.elapsed().as_secs_f64() * 1e3;
-    let global_began = Instant::now();
-    finish_on(
-        exec,
-        &problem.scene,
-        &problem.start,
-        &goal,
-        guides,
-        config,
-        &mut rng,
-        scratches,
-        &mut work,
-        &mut plan,
-    )
-    .map_err(|e| Failure::Input(format!("planner: {e}")))?;
-    let global_ms = global_began.elapsed().as_secs_f64() * 1e3;
-    let shortcut_began = Instant::now();
-    polish(&problem.scene, &problem.start, &goal, config, &mut rng, &mut plan)
-        .map_err(|e| Failure::Input(format!("planner: {e}")))?;
-    let shortcut_ms = shortcut_began.elapsed().as_secs_f64() * 1e3;
+    let [denoise_ms, select_ms, global_ms, shortcut_ms] = stopwatch.ms;
     Ok(Planned {
         plan,
         ik_ms,
@@ -495,6 +465,31 @@ fn plan_with<E: Executor, const C: usize>(
         global_ms,
         shortcut_ms,
     })
+}
+
+/// Milliseconds in each [`Phase`] of the core's pipeline, in its order.
+#[derive(Default)]
+struct Stopwatch {
+    began: Option<Instant>,
+    ms: [f64; 4],
+}
+
+impl Observer for Stopwatch {
+    fn begin(&mut self, _: Phase) {
+        self.began = Some(Instant::now());
+    }
+
+    fn end(&mut self, phase: Phase) {
+        let slot = match phase {
+            Phase::FirstStage => 0,
+            Phase::Judge => 1,
+            Phase::GlobalStage => 2,
+            Phase::Shortcut => 3,
+        };
+        if let Some(began) = self.began.take() {
+            self.ms[slot] += began.elapsed().as_secs_f64() * 1e3;
+        }
+    }
 }
 
 /// The guides named on the command line (all of EDMP's when none).

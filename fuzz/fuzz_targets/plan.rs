@@ -7,9 +7,9 @@
 
 use edmp_core::collision::checker::CheckConfig;
 use edmp_core::cost::boxes::{BoxFrame, CylinderBox};
-use edmp_core::planner::global::GlobalConfig;
+use edmp_core::planner::GlobalConfig;
 use edmp_core::guidance::guides::{CLEARANCE_GUIDE, EDMP_GUIDES};
-use edmp_core::planner::{GuidanceSchedule, Judging, PlanConfig, RefineStop, Workspace, plan};
+use edmp_core::planner::{Request, GuidanceSchedule, Judging, PlanConfig, RefineStop, Workspace, plan};
 use edmp_core::prior::{Sampler, Scratch};
 use edmp_core::path::HORIZON;
 use edmp_core::rng::Rng;
@@ -156,16 +156,7 @@ fuzz_target!(|data: &[u8]| {
         g.smooth = if extra & 4 != 0 { 0.1 } else { 0.0 };
     }
     let guides = &table[..count];
-    if let Ok(p) = plan(
-        &scene,
-        &start,
-        &goal,
-        guides,
-        &config,
-        &mut Rng::new(seed),
-        &mut scratch,
-        &mut work,
-    ) {
+    if let Ok(p) = plan(&Request { scene: &scene, start: &start, goal: &goal, guides: guides, config: &config }, &mut Rng::new(seed), &mut scratch, &mut work) {
         assert!(steps >= 1);
         for (path, verdict) in p.paths.iter().zip(&p.verdicts) {
             assert!(path.iter().flatten().all(|v| v.is_finite()));

@@ -31,24 +31,14 @@ use crate::scene::Scene;
 /// a fixed `t` a guide's step depends only on its rows, so the next step of a settled guide would
 /// be the same no-op: skipping it saves the work and changes no bit. Clear the flags whenever
 /// `t` (or the scene) changes. Any other length is [`Error::BadParameter`].
-#[allow(clippy::too_many_arguments)]
 pub fn guide_step<const H: usize, const N: usize>(
     scene: &Scene<N>,
     rows: &mut [[Joints<f32>; H]],
     grads: &mut [[Joints<f32>; H]],
-    guides: &[Guide],
-    t: u16,
-    step_limit: f32,
-    cylinder: CylinderBox,
-    frame: BoxFrame,
+    step: &GuideStep<'_>,
     settled: &mut [bool],
 ) -> Result<(), Error> {
-    let rule = StepRule {
-        step_limit,
-        cylinder,
-        frame,
-    };
-    step_rows(scene, rows, grads, guides, t, &rule, settled, &mut [], None)
+    step_rows(scene, rows, grads, step, settled, &mut [], None)
 }
 
 /// [`guide_step`] with the guides cut into groups run by `exec` (each group steps its own
@@ -58,21 +48,19 @@ pub fn guide_step<const H: usize, const N: usize>(
 /// segments that reached nothing at the last step and have not moved since (the same bits).
 /// Keep them for the steps at one `t` and start them at [`CostMemo::NONE`] whenever the rows
 /// change otherwise (a denoising step) or the scene does.
-#[allow(clippy::too_many_arguments)]
 pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
     exec: &E,
     scene: &Scene<N>,
     rows: &mut [[Joints<f32>; H]],
     grads: &mut [[Joints<f32>; H]],
-    guides: &[Guide],
-    t: u16,
-    rule: &StepRule,
+    step: &GuideStep<'_>,
     settled: &mut [bool],
     memos: &mut [CostMemo],
 ) -> Result<(), Error> {
     if exec.parts() <= 1 {
-        return step_rows(scene, rows, grads, guides, t, rule, settled, memos, None);
+        return step_rows(scene, rows, grads, step, settled, memos, None);
     }
+    let guides = step.guides;
     check_batch(rows.len(), grads.len(), guides.len(), settled.len(), memos.len())?;
     struct Part<'a, const H: usize> {
         guides: &'a [Guide],
@@ -109,7 +97,15 @@ pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
         }
     }
     exec.each(&mut parts, |p| {
-        step_rows(scene, p.rows, p.grads, p.guides, t, rule, p.settled, p.memos, None)
+        step_rows(
+            scene,
+            p.rows,
+            p.grads,
+            &step.with_guides(p.guides),
+            p.settled,
+            p.memos,
+            None,
+        )
     })
 }
 
@@ -121,6 +117,25 @@ fn check_batch(rows: usize, grads: usize, guides: usize, settled: usize, memos: 
         Ok(())
     } else {
         Err(Error::BadParameter)
+    }
+}
+
+/// One guidance step's settings: the guides (one per `rows.len() / guides.len()` rows), the
+/// diffusion step `t` their schedules are read at, and how rows move ([`StepRule`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuideStep<'a> {
+    /// The guides; rows `g·k … g·k + k − 1` follow guide `g`.
+    pub guides: &'a [Guide],
+    /// The diffusion step (1 in the refinement).
+    pub t: u16,
+    /// The step limit and how the costs box things.
+    pub rule: StepRule,
+}
+
+impl<'a> GuideStep<'a> {
+    /// The same step for another set of guides (a part of the batch).
+    pub fn with_guides(&self, guides: &'a [Guide]) -> Self {
+        Self { guides, ..*self }
     }
 }
 
@@ -156,36 +171,32 @@ pub const MIN_STEP_SCALE: f32 = 1.0 / 64.0;
 
 /// [`guide_step`] with step-size control ([`StepControl`], one entry per guide in `best` and
 /// `scale`, one saved row per row; other lengths are [`Error::BadParameter`]).
-#[allow(clippy::too_many_arguments)]
 pub fn guide_step_controlled<const H: usize, const N: usize>(
     scene: &Scene<N>,
     rows: &mut [[Joints<f32>; H]],
     grads: &mut [[Joints<f32>; H]],
-    guides: &[Guide],
-    t: u16,
-    rule: &StepRule,
+    step: &GuideStep<'_>,
     settled: &mut [bool],
     control: &mut StepControl<'_, H>,
 ) -> Result<(), Error> {
-    if control.saved.len() != rows.len() || control.best.len() != guides.len() || control.scale.len() != guides.len() {
+    let guides = step.guides.len();
+    if control.saved.len() != rows.len() || control.best.len() != guides || control.scale.len() != guides {
         return Err(Error::BadParameter);
     }
-    step_rows(scene, rows, grads, guides, t, rule, settled, &mut [], Some(control))
+    step_rows(scene, rows, grads, step, settled, &mut [], Some(control))
 }
 
-#[allow(clippy::too_many_arguments)]
 #[inline(never)] // one symbol for profiles (benchmarks/stage_instructions.py); it is large anyway
 fn step_rows<const H: usize, const N: usize>(
     scene: &Scene<N>,
     rows: &mut [[Joints<f32>; H]],
     grads: &mut [[Joints<f32>; H]],
-    guides: &[Guide],
-    t: u16,
-    rule: &StepRule,
+    step: &GuideStep<'_>,
     settled: &mut [bool],
     memos: &mut [CostMemo],
     mut control: Option<&mut StepControl<'_, H>>,
 ) -> Result<(), Error> {
+    let GuideStep { guides, t, ref rule } = *step;
     let step_limit = rule.step_limit;
     if step_limit.is_nan() || step_limit <= 0.0 {
         return Err(Error::BadParameter);
@@ -379,11 +390,15 @@ mod tests {
                 &scene,
                 &mut rows,
                 &mut grads,
-                &[small],
-                t,
-                f32::INFINITY,
-                CylinderBox::Enclosing,
-                BoxFrame::Obstacle,
+                &GuideStep {
+                    guides: &[small],
+                    t,
+                    rule: StepRule {
+                        step_limit: f32::INFINITY,
+                        cylinder: CylinderBox::Enclosing,
+                        frame: BoxFrame::Obstacle,
+                    },
+                },
                 &mut [],
             )
             .unwrap();
@@ -414,9 +429,11 @@ mod tests {
                 &scene,
                 &mut whole,
                 &mut grads,
-                &EDMP_GUIDES,
-                30,
-                &rule,
+                &GuideStep {
+                    guides: &EDMP_GUIDES,
+                    t: 30,
+                    rule: rule,
+                },
                 &mut settled,
                 &mut [],
                 None,
@@ -436,9 +453,11 @@ mod tests {
                         &scene,
                         &mut rows,
                         &mut grads,
-                        &EDMP_GUIDES,
-                        30,
-                        &rule,
+                        &GuideStep {
+                            guides: &EDMP_GUIDES,
+                            t: 30,
+                            rule: rule,
+                        },
                         &mut flags,
                         memos,
                     )
@@ -466,11 +485,15 @@ mod tests {
             &empty,
             &mut rows,
             &mut grads,
-            &EDMP_GUIDES,
-            100,
-            f32::INFINITY,
-            CylinderBox::Enclosing,
-            BoxFrame::Obstacle,
+            &GuideStep {
+                guides: &EDMP_GUIDES,
+                t: 100,
+                rule: StepRule {
+                    step_limit: f32::INFINITY,
+                    cylinder: CylinderBox::Enclosing,
+                    frame: BoxFrame::Obstacle,
+                },
+            },
             &mut [],
         )
         .unwrap();
@@ -507,11 +530,15 @@ mod tests {
             &scene,
             &mut r1,
             &mut g1,
-            &[guide],
-            50,
-            f32::INFINITY,
-            CylinderBox::Enclosing,
-            BoxFrame::Obstacle,
+            &GuideStep {
+                guides: &[guide],
+                t: 50,
+                rule: StepRule {
+                    step_limit: f32::INFINITY,
+                    cylinder: CylinderBox::Enclosing,
+                    frame: BoxFrame::Obstacle,
+                },
+            },
             &mut [],
         )
         .unwrap();
@@ -519,11 +546,15 @@ mod tests {
             &scene,
             &mut r2,
             &mut g2,
-            &[guide],
-            50,
-            f32::INFINITY,
-            CylinderBox::Enclosing,
-            BoxFrame::Obstacle,
+            &GuideStep {
+                guides: &[guide],
+                t: 50,
+                rule: StepRule {
+                    step_limit: f32::INFINITY,
+                    cylinder: CylinderBox::Enclosing,
+                    frame: BoxFrame::Obstacle,
+                },
+            },
             &mut [],
         )
         .unwrap();
@@ -560,11 +591,15 @@ mod tests {
                     &scene,
                     &mut rows,
                     &mut grads,
-                    &guides,
-                    1,
-                    0.1,
-                    CylinderBox::Enclosing,
-                    BoxFrame::Obstacle,
+                    &GuideStep {
+                        guides: &guides,
+                        t: 1,
+                        rule: StepRule {
+                            step_limit: 0.1,
+                            cylinder: CylinderBox::Enclosing,
+                            frame: BoxFrame::Obstacle,
+                        },
+                    },
                     flags,
                 )
                 .unwrap();
@@ -588,11 +623,15 @@ mod tests {
             &scene,
             &mut rows,
             &mut grads,
-            &guides,
-            1,
-            0.1,
-            CylinderBox::Enclosing,
-            BoxFrame::Obstacle,
+            &GuideStep {
+                guides: &guides,
+                t: 1,
+                rule: StepRule {
+                    step_limit: 0.1,
+                    cylinder: CylinderBox::Enclosing,
+                    frame: BoxFrame::Obstacle,
+                },
+            },
             &mut [false; 3],
         );
         assert_eq!(err, Err(Error::BadParameter));
@@ -606,11 +645,15 @@ mod tests {
             &Scene::<4>::new(),
             &mut rows,
             &mut grads,
-            &EDMP_GUIDES,
-            10,
-            f32::INFINITY,
-            CylinderBox::Enclosing,
-            BoxFrame::Obstacle,
+            &GuideStep {
+                guides: &EDMP_GUIDES,
+                t: 10,
+                rule: StepRule {
+                    step_limit: f32::INFINITY,
+                    cylinder: CylinderBox::Enclosing,
+                    frame: BoxFrame::Obstacle,
+                },
+            },
             &mut [],
         );
         assert_eq!(err, Err(Error::BadParameter));
@@ -620,11 +663,15 @@ mod tests {
             &Scene::<4>::new(),
             &mut twelve,
             &mut short,
-            &EDMP_GUIDES,
-            10,
-            f32::INFINITY,
-            CylinderBox::Enclosing,
-            BoxFrame::Obstacle,
+            &GuideStep {
+                guides: &EDMP_GUIDES,
+                t: 10,
+                rule: StepRule {
+                    step_limit: f32::INFINITY,
+                    cylinder: CylinderBox::Enclosing,
+                    frame: BoxFrame::Obstacle,
+                },
+            },
             &mut [],
         );
         assert_eq!(err, Err(Error::BadParameter));
@@ -643,11 +690,15 @@ mod tests {
             &scene,
             &mut free,
             &mut grads,
-            &[guide],
-            200,
-            f32::INFINITY,
-            CylinderBox::Enclosing,
-            BoxFrame::Obstacle,
+            &GuideStep {
+                guides: &[guide],
+                t: 200,
+                rule: StepRule {
+                    step_limit: f32::INFINITY,
+                    cylinder: CylinderBox::Enclosing,
+                    frame: BoxFrame::Obstacle,
+                },
+            },
             &mut [],
         )
         .unwrap();
@@ -665,11 +716,15 @@ mod tests {
             &scene,
             &mut limited,
             &mut grads,
-            &[guide],
-            200,
-            0.02,
-            CylinderBox::Enclosing,
-            BoxFrame::Obstacle,
+            &GuideStep {
+                guides: &[guide],
+                t: 200,
+                rule: StepRule {
+                    step_limit: 0.02,
+                    cylinder: CylinderBox::Enclosing,
+                    frame: BoxFrame::Obstacle,
+                },
+            },
             &mut [],
         )
         .unwrap();
@@ -680,11 +735,15 @@ mod tests {
                 &scene,
                 &mut limited,
                 &mut grads,
-                &[guide],
-                200,
-                bad,
-                CylinderBox::Enclosing,
-                BoxFrame::Obstacle,
+                &GuideStep {
+                    guides: &[guide],
+                    t: 200,
+                    rule: StepRule {
+                        step_limit: bad,
+                        cylinder: CylinderBox::Enclosing,
+                        frame: BoxFrame::Obstacle,
+                    },
+                },
                 &mut [],
             );
             assert_eq!(err, Err(Error::BadParameter));
@@ -740,11 +799,15 @@ mod tests {
                     scene,
                     &mut rows,
                     &mut grads,
-                    &[g],
-                    1,
-                    0.1,
-                    CylinderBox::Enclosing,
-                    BoxFrame::Obstacle,
+                    &GuideStep {
+                        guides: &[g],
+                        t: 1,
+                        rule: StepRule {
+                            step_limit: 0.1,
+                            cylinder: CylinderBox::Enclosing,
+                            frame: BoxFrame::Obstacle,
+                        },
+                    },
                     &mut [],
                 )
                 .unwrap();
@@ -791,9 +854,11 @@ mod tests {
                 &scene,
                 &mut rows,
                 &mut grads,
-                &guides,
-                1,
-                &rule,
+                &GuideStep {
+                    guides: &guides,
+                    t: 1,
+                    rule: rule,
+                },
                 &mut settled,
                 &mut control,
             )
@@ -812,9 +877,11 @@ mod tests {
             &scene,
             &mut rows,
             &mut grads,
-            &guides,
-            1,
-            &rule,
+            &GuideStep {
+                guides: &guides,
+                t: 1,
+                rule: rule,
+            },
             &mut settled,
             &mut StepControl {
                 saved: &mut saved[..1],

@@ -68,11 +68,9 @@ impl SearchConfig {
     /// The planner's fallback setting: the host's RRT baseline's step, and all of the space's
     /// capacity (a plan's bits depend on it: the host's CLI holds 4,096 nodes per tree, the
     /// firmware and `edmp-host embed` 512). 8,000 iterations: on the suites, the problems the
-    /// first stage leaves need up to about 5,300. 25 shortcut attempts (the baseline's 100
-    /// until the eleventh session): the prior reshapes the path and the winner is shortened
-    /// again, so 75 more attempts bought nothing measurable (the same stages and path lengths
-    /// on the 127 problems that need three waves or more) for 5.5 % of a global-stage plan's
-    /// instructions (docs/benchmark.md, eleventh session).
+    /// first stage leaves need up to about 5,300. 25 shortcut attempts (the RRT baseline makes
+    /// 100): the prior reshapes the path and the winner is shortened again, so more attempts
+    /// buy nothing measurable (docs/benchmark.md).
     pub const DEFAULT: Self = Self {
         max_iterations: 8000,
         step: 0.3,
@@ -236,8 +234,11 @@ pub fn search_from<const CAP: usize>(
     if capacity == 0 {
         return Err(Error::BadParameter);
     }
-    let mut oracle = Oracle { edge_free, calls: 0 };
-    let mut iterations = 0u32;
+    let mut oracle = Oracle {
+        edge_free,
+        calls: 0,
+        iterations: 0,
+    };
     space.len = [0; 2];
     let corners = if oracle.free(start, goal)? {
         // Slots 0 and 1 exist: the two trees hold at least one node each.
@@ -248,18 +249,7 @@ pub fn search_from<const CAP: usize>(
         space.len = [1, 1];
         2
     } else {
-        let Some((s, g)) = grow(
-            start,
-            goal,
-            seed,
-            config,
-            capacity,
-            space,
-            rng,
-            &mut oracle,
-            &mut iterations,
-        )?
-        else {
+        let Some((s, g)) = grow(start, goal, seed, config, space, rng, &mut oracle)? else {
             return Ok(None);
         };
         join(space, s, g)
@@ -287,7 +277,7 @@ pub fn search_from<const CAP: usize>(
         corners,
         even,
         nodes,
-        iterations,
+        iterations: oracle.iterations,
         oracle_calls: oracle.calls,
     }))
 }
@@ -301,7 +291,11 @@ pub fn shortcut_polyline(
     rng: &mut Rng,
     edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
 ) -> Result<(usize, u32), Error> {
-    let mut oracle = Oracle { edge_free, calls: 0 };
+    let mut oracle = Oracle {
+        edge_free,
+        calls: 0,
+        iterations: 0,
+    };
     let n = shortcut(path, attempts, rng, &mut oracle)?;
     Ok((n, oracle.calls))
 }
@@ -310,6 +304,8 @@ pub fn shortcut_polyline(
 struct Oracle<'f, F> {
     edge_free: &'f mut F,
     calls: u32,
+    /// Growing iterations spent, counted by [`grow`].
+    iterations: u32,
 }
 
 impl<F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>> Oracle<'_, F> {
@@ -407,21 +403,19 @@ where
 
 /// Grows the start tree (space tree 0) and the goal tree (tree 1) in turn until they meet:
 /// the meeting node's index in each, or `None` when the budget runs out.
-#[allow(clippy::too_many_arguments)]
 fn grow<const CAP: usize, F>(
     start: &Joints<f32>,
     goal: &Joints<f32>,
     seed: &[Joints<f32>],
     config: &SearchConfig,
-    capacity: usize,
     space: &mut SearchSpace<CAP>,
     rng: &mut Rng,
     oracle: &mut Oracle<'_, F>,
-    iterations: &mut u32,
 ) -> Result<Option<(usize, usize)>, Error>
 where
     F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
 {
+    let capacity = config.tree_capacity(CAP);
     let SearchSpace {
         nodes: [n0, n1],
         parents: [p0, p1],
@@ -454,8 +448,8 @@ where
         }
     }
     let mut from_start = true;
-    while *iterations < config.max_iterations {
-        *iterations = iterations.saturating_add(1);
+    while oracle.iterations < config.max_iterations {
+        oracle.iterations = oracle.iterations.saturating_add(1);
         let mut sample = [0.0f32; JOINTS];
         for ((v, lo), hi) in sample.iter_mut().zip(&PANDA.soft_lower).zip(&PANDA.soft_upper) {
             *v = rng.uniform_f32(*lo, *hi);
@@ -1199,6 +1193,7 @@ mod tests {
         let mut oracle = Oracle {
             edge_free: &mut o,
             calls: 0,
+            iterations: 0,
         };
         let n = shortcut(&mut path, 200, &mut Rng::new(2), &mut oracle).unwrap();
         assert_eq!(n, 2);

@@ -76,11 +76,9 @@ pub struct ShortcutReport {
 /// Shortens the free trajectory `path` from `start` to `goal` in `scene`, in place; `path`
 /// changes only to trajectories that pass `check` in full (the same rule as the selection:
 /// `end_margin` near the ends, `margin` elsewhere). Call it on a path that passed `check`.
-#[allow(clippy::too_many_arguments)]
 pub fn shorten<const N: usize>(
     scene: &Scene<N>,
-    start: &Joints<f32>,
-    goal: &Joints<f32>,
+    [start, goal]: [&Joints<f32>; 2],
     check: &CheckConfig,
     config: &ShortcutConfig,
     rng: &mut Rng,
@@ -108,7 +106,7 @@ pub fn shorten<const N: usize>(
     let even = (n < HORIZON).then(|| resample_even(corners));
     let dropped = u8::try_from(HORIZON.saturating_sub(n)).unwrap_or(u8::MAX);
     // Most plans keep every smoothing pass of the evenly resampled polyline (758 of the 800
-    // suite plans, 2026-12-03): that end is checked first, one full check instead of one per
+    // suite plans): that end is checked first, one full check instead of one per
     // step. Only when it fails are the steps checked one by one, as below.
     if config.smoothing > 0 {
         let mut smoothed = even.unwrap_or(*path);
@@ -255,8 +253,7 @@ mod tests {
         assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
         let report = shorten(
             &scene,
-            &START,
-            &GOAL,
+            [&START, &GOAL],
             &check,
             &ShortcutConfig::DEFAULT,
             &mut Rng::new(1),
@@ -290,8 +287,7 @@ mod tests {
         );
         shorten(
             &scene,
-            &START,
-            &GOAL,
+            [&START, &GOAL],
             &check,
             &ShortcutConfig::DEFAULT,
             &mut Rng::new(2),
@@ -309,8 +305,7 @@ mod tests {
             let mut path = detour();
             shorten(
                 &scene,
-                &START,
-                &GOAL,
+                [&START, &GOAL],
                 &check,
                 &ShortcutConfig::DEFAULT,
                 &mut Rng::new(seed),
@@ -381,7 +376,7 @@ mod tests {
             }
             let mut reference = path;
             let kept = step_by_step(&scene, &check, &config, case, &mut reference);
-            let report = shorten(&scene, &START, &GOAL, &check, &config, &mut Rng::new(case), &mut path).unwrap();
+            let report = shorten(&scene, [&START, &GOAL], &check, &config, &mut Rng::new(case), &mut path).unwrap();
             assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
             if kept == config.smoothing {
                 assert_eq!(path, reference, "case {case}");

@@ -26,7 +26,7 @@ use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
 use cortex_m_semihosting::hio::{self, HostStream};
 use edmp_core::Error;
 use edmp_core::guidance::guides::EDMP_GUIDES;
-use edmp_core::planner::{Plan, PlanConfig, Workspace, plan};
+use edmp_core::planner::{Request, Plan, PlanConfig, Workspace, plan};
 use edmp_core::prior::{STEPS, Scratch, TimeEmbedding, initial_noise, predict_noise};
 use edmp_core::path::{HORIZON, Path};
 use edmp_core::rng::Rng;
@@ -268,16 +268,7 @@ fn decode(bytes: &[u8]) -> Result<(Problem<OBSTACLES>, Scene<OBSTACLES>), Failur
 fn plan_scene(bytes: &[u8], scratch: &mut Scratch<1>, work: &mut Workspace<ROWS>) -> Result<Summary, Failure> {
     let (problem, scene) = decode(bytes)?;
     let mut rng = Rng::new(problem.seed);
-    let plan: Plan<ROWS> = plan::<ROWS, OBSTACLES, 1, { edmp_core::planner::DEFAULT_SEARCH_NODES }>(
-        &scene,
-        &problem.start,
-        &problem.goal,
-        &EDMP_GUIDES,
-        &PlanConfig::DEFAULT,
-        &mut rng,
-        scratch,
-        work,
-    )
+    let plan: Plan<ROWS> = plan::<ROWS, OBSTACLES, 1, { edmp_core::planner::DEFAULT_SEARCH_NODES }>(&Request { scene: &scene, start: &problem.start, goal: &problem.goal, guides: &EDMP_GUIDES, config: &PlanConfig::DEFAULT }, &mut rng, scratch, work)
     .map_err(Failure::Plan)?;
     let path = plan.paths.get(plan.best).copied().unwrap_or([[0.0; JOINTS]; HORIZON]);
     Ok(Summary {

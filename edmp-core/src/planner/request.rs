@@ -1,0 +1,30 @@
+//! One planning request: what every stage of the pipeline reads and none of them changes.
+
+use crate::guidance::guides::Guide;
+use crate::planner::PlanConfig;
+use crate::robot::kinematics::Joints;
+use crate::scene::Scene;
+
+/// The problem (scene, start, goal), the guides its rows follow and the tuning, travelling
+/// together through the stages. Row `r` of a batch of `B` follows guide `r / (B / guides.len())`.
+#[derive(Clone, Copy, Debug)]
+pub struct Request<'a, const N: usize> {
+    /// The obstacles, the held object and the gripper opening.
+    pub scene: &'a Scene<N>,
+    /// The first waypoint of every candidate.
+    pub start: &'a Joints<f32>,
+    /// The last waypoint of every candidate.
+    pub goal: &'a Joints<f32>,
+    /// The guides the rows follow (EDMP's ensemble: [`crate::guidance::guides::EDMP_GUIDES`]).
+    pub guides: &'a [Guide],
+    /// Everything else the planner is told.
+    pub config: &'a PlanConfig,
+}
+
+impl<'a, const N: usize> Request<'a, N> {
+    /// The same request for another set of guides: a wave of the ensemble
+    /// ([`PlanConfig::waves`]) runs its own guides on its own rows.
+    pub fn with_guides(&self, guides: &'a [Guide]) -> Self {
+        Self { guides, ..*self }
+    }
+}
