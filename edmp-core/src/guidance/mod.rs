@@ -432,7 +432,7 @@ mod tests {
                 &GuideStep {
                     guides: &EDMP_GUIDES,
                     t: 30,
-                    rule: rule,
+                    rule,
                 },
                 &mut settled,
                 &mut [],
@@ -456,7 +456,7 @@ mod tests {
                         &GuideStep {
                             guides: &EDMP_GUIDES,
                             t: 30,
-                            rule: rule,
+                            rule,
                         },
                         &mut flags,
                         memos,
@@ -857,7 +857,7 @@ mod tests {
                 &GuideStep {
                     guides: &guides,
                     t: 1,
-                    rule: rule,
+                    rule,
                 },
                 &mut settled,
                 &mut control,
@@ -880,7 +880,7 @@ mod tests {
             &GuideStep {
                 guides: &guides,
                 t: 1,
-                rule: rule,
+                rule,
             },
             &mut settled,
             &mut StepControl {

@@ -60,7 +60,7 @@ fn plan_wall<const B: usize, const C: usize>(
         &Request {
             scene: &wall_scene(),
             start: &START,
-            goal: goal,
+            goal,
             guides: &EDMP_GUIDES,
             config: &config(),
         },
@@ -344,7 +344,7 @@ fn refine_batch(
     refine::<_, 12, 4>(
         &Serial,
         &Request {
-            scene: scene,
+            scene,
             start: &START,
             goal: &GOAL,
             guides: &EDMP_GUIDES,

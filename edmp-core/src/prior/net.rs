@@ -601,22 +601,27 @@ fn conv_groups<const K: usize, const S: usize>(
     let mut co0 = 0;
     while co0 < conv.cout {
         if co0 + TILE_CHANNELS <= conv.cout {
-            conv_rows::<TILE_CHANNELS, K, S>(conv, input, lay, lay_out, co0, out, mode, wbuf);
+            conv_rows::<TILE_CHANNELS, K, S>(conv, input, Layouts { lay, lay_out }, co0, out, mode, wbuf);
             co0 += TILE_CHANNELS;
         } else {
-            conv_rows::<1, K, S>(conv, input, lay, lay_out, co0, out, mode, wbuf);
+            conv_rows::<1, K, S>(conv, input, Layouts { lay, lay_out }, co0, out, mode, wbuf);
             co0 += 1;
         }
     }
 }
 
+/// The layouts a convolution reads its input in and writes its output in.
+#[derive(Clone, Copy)]
+struct Layouts {
+    lay: Layout,
+    lay_out: Layout,
+}
+
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn conv_rows<const CO: usize, const K: usize, const S: usize>(
     conv: &Conv,
     input: &[f32],
-    lay: Layout,
-    lay_out: Layout,
+    Layouts { lay, lay_out }: Layouts,
     co0: usize,
     out: &mut [f32],
     mode: Accumulate,
