@@ -349,7 +349,9 @@ fn path_of(v: &Value, path: &str) -> Result<Vec<Joints<f32>>, InputError> {
 /// Parses an `edmp-plan/1` document (what `edmp-host plan` writes) for reading back.
 pub fn parse_plan(text: &str) -> Result<PlanDocument, InputError> {
     let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
-    let map = root.as_object().ok_or_else(|| InputError::at("", "expected an object"))?;
+    let map = root
+        .as_object()
+        .ok_or_else(|| InputError::at("", "expected an object"))?;
     let (format, fp) = field(map, "", "format")?;
     if format.as_str() != Some("edmp-plan/1") {
         return Err(InputError::at(&fp, format!("expected \"edmp-plan/1\", found {format}")));
@@ -376,12 +378,17 @@ pub fn parse_plan(text: &str) -> Result<PlanDocument, InputError> {
         }
         for (i, point) in points.iter().enumerate() {
             let at = format!("{pp}[{i}]");
-            let pm = point.as_object().ok_or_else(|| InputError::at(&at, "expected an object"))?;
+            let pm = point
+                .as_object()
+                .ok_or_else(|| InputError::at(&at, "expected an object"))?;
             let (q, qp) = field(pm, &at, "positions")?;
             let (time, tp) = field(pm, &at, "time_from_start")?;
             let time = number(time, &tp)?;
             if trajectory.last().is_some_and(|&(before, _)| time < before) {
-                return Err(InputError::at(&tp, format!("{time} is before the previous point's time")));
+                return Err(InputError::at(
+                    &tp,
+                    format!("{time} is before the previous point's time"),
+                ));
             }
             trajectory.push((time, numbers::<JOINTS>(q, &qp)?));
         }
@@ -411,9 +418,9 @@ pub fn parse_plan(text: &str) -> Result<PlanDocument, InputError> {
             .as_object()
             .ok_or_else(|| InputError::at("timing_ms", "expected an object"))?;
         for (key, value) in tm {
-            let ms = value
-                .as_f64()
-                .ok_or_else(|| InputError::at(&format!("timing_ms.{key}"), format!("expected a number, found {value}")))?;
+            let ms = value.as_f64().ok_or_else(|| {
+                InputError::at(&format!("timing_ms.{key}"), format!("expected a number, found {value}"))
+            })?;
             timing_ms.push((key.clone(), ms));
         }
     }

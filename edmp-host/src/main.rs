@@ -3,7 +3,8 @@
 
 use clap::{Parser, Subcommand};
 use edmp_host::{
-    Failure, bench, bench_report, bench_rrt, embed, fk, gen_data, moveit, plan_cmd, render, rrt_cmd, sample, suite, view,
+    Failure, bench, bench_report, bench_rrt, embed, fk, gen_data, moveit, plan_cmd, render, rrt_cmd, sample, suite,
+    view,
 };
 use std::process::ExitCode;
 

@@ -106,7 +106,8 @@ pub const MAX_SAMPLE_RATE: f32 = 50.0;
 /// Reads the scene (and plan), writes the page. Bad input: exit 2 naming the file and JSON path,
 /// nothing written.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let read = |path: &Path| std::fs::read_to_string(path).map_err(|e| Failure::Input(format!("{}: {e}", path.display())));
+    let read =
+        |path: &Path| std::fs::read_to_string(path).map_err(|e| Failure::Input(format!("{}: {e}", path.display())));
     let text = read(&args.scene)?;
     let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let plan = match &args.plan {
@@ -399,7 +400,11 @@ fn parse_obj(text: &str, colours: &[(String, [f32; 3])]) -> Result<Mesh, String>
         let mut parts = line.split_whitespace();
         match parts.next() {
             Some("v") => {
-                let xyz: Vec<f32> = parts.take(3).map(str::parse).collect::<Result<_, _>>().map_err(|e| format!("{}: {e}", at()))?;
+                let xyz: Vec<f32> = parts
+                    .take(3)
+                    .map(str::parse)
+                    .collect::<Result<_, _>>()
+                    .map_err(|e| format!("{}: {e}", at()))?;
                 if xyz.len() != 3 {
                     return Err(format!("{}: a vertex needs 3 coordinates", at()));
                 }
@@ -407,7 +412,10 @@ fn parse_obj(text: &str, colours: &[(String, [f32; 3])]) -> Result<Mesh, String>
             }
             Some("usemtl") => {
                 let name = parts.next().unwrap_or_default();
-                colour = colours.iter().find(|(m, _)| m == name).map_or(DEFAULT_COLOUR, |(_, c)| *c);
+                colour = colours
+                    .iter()
+                    .find(|(m, _)| m == name)
+                    .map_or(DEFAULT_COLOUR, |(_, c)| *c);
             }
             Some("f") => {
                 let ids: Vec<u32> = parts
@@ -503,7 +511,11 @@ mod tests {
         assert_eq!(mesh.groups[0].colour, DEFAULT_COLOUR);
         assert_eq!((mesh.groups[1].start, mesh.groups[1].count), (6, 3));
         assert_eq!(mesh.groups[1].colour, [0.25; 3]);
-        assert!(parse_obj("v 0 0 0\nf 1 2 3\n", &mtl).unwrap_err().starts_with("line 2: bad vertex index"));
+        assert!(
+            parse_obj("v 0 0 0\nf 1 2 3\n", &mtl)
+                .unwrap_err()
+                .starts_with("line 2: bad vertex index")
+        );
     }
 
     #[test]
