@@ -553,4 +553,37 @@ mod tests {
         assert!(closed.starts_with("start: in collision: panda_"), "{closed}");
         assert!(closed.contains("finger touches obstacles[0]"), "{closed}");
     }
+
+    #[test]
+    fn plan_errors_name_the_field() {
+        let q = "[0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785]";
+        let plan =
+            |rest: &str| format!(r#"{{"format": "edmp-plan/1", "status": "success", "waypoints": [{q}, {q}]{rest}}}"#);
+        let ok = parse_plan(&plan(r#", "timing_ms": {"total": 1.5}"#)).unwrap();
+        assert_eq!(
+            (ok.waypoints.len(), ok.timing_ms.clone()),
+            (2, vec![("total".to_string(), 1.5)])
+        );
+        let error = |text: &str| parse_plan(text).unwrap_err().to_string();
+        assert_eq!(
+            error(&plan("").replace("plan/1", "scene/1")),
+            r#"format: expected "edmp-plan/1", found "edmp-scene/1""#
+        );
+        let timed = format!(
+            r#", "trajectory": {{"points": [{{"positions": {q}, "time_from_start": 0.5}}, {{"positions": {q}, "time_from_start": 0.25}}]}}"#
+        );
+        assert_eq!(
+            error(&plan(&timed)),
+            "trajectory.points[1].time_from_start: 0.25 is before the previous point's time"
+        );
+        let candidate = format!(r#", "candidates": [{{"collision_free": "yes", "waypoints": [{q}]}}]"#);
+        assert_eq!(
+            error(&plan(&candidate)),
+            r#"candidates[0].collision_free: expected true or false, found "yes""#
+        );
+        assert_eq!(
+            error(&plan("").replace(&format!("[{q}, {q}]"), "[]")),
+            "waypoints: no waypoints"
+        );
+    }
 }

@@ -246,7 +246,5 @@ fn view_page(scene: &str, plan: Option<&str>, title: &str) -> PyResult<String> {
 #[pymodule]
 mod _edmp {
     #[pymodule_export]
-    use super::{
-        PlanError, SceneError, check, fk, ik, import_moveit, plan, plan_problem_ms, validate, view_page,
-    };
+    use super::{PlanError, SceneError, check, fk, ik, import_moveit, plan, plan_problem_ms, validate, view_page};
 }

@@ -279,7 +279,8 @@ def test_show_returns_an_inline_page_in_jupyter(
     pytest.importorskip("IPython")
     monkeypatch.setattr(edmp, "_in_notebook", lambda: True)
     shown = edmp.show(wall, wall_plan)
-    assert type(shown).__name__ == "HTML" and shown.data.startswith("<iframe srcdoc=")
+    assert type(shown).__name__ == "HTML" and shown.data.startswith("<div><iframe srcdoc=")
+    assert "edmp-data" in shown.data and "<script" not in shown.data  # the page is escaped
 
 
 @pytest.mark.skipif(HOST is None, reason="EDMP_HOST (the edmp-host binary) not set")

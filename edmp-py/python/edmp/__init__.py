@@ -392,7 +392,7 @@ def show(
 
         # In its own document (srcdoc), so the page's scripts do not meet the notebook's.
         frame = f'<iframe srcdoc="{html.escape(page, quote=True)}" style="width: 100%; height: 600px; border: 0"></iframe>'
-        return HTML(frame)
+        return HTML(f"<div>{frame}</div>")
     if path is None:
         handle, name = tempfile.mkstemp(prefix="edmp-view-", suffix=".html")
         with os.fdopen(handle, "w", encoding="utf-8") as f:
