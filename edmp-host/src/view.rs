@@ -528,4 +528,45 @@ mod tests {
         let q = right["quaternion"].as_array().unwrap();
         assert!(q[0].as_f64().unwrap().abs() < 1e-9 && (q[3].as_f64().unwrap().abs() - 1.0).abs() < 1e-9);
     }
+
+    fn embedded_data(html: &str) -> Value {
+        let start = html.find(r#"id="edmp-data">"#).unwrap() + r#"id="edmp-data">"#.len();
+        let end = start + html[start..].find("</script>").unwrap();
+        serde_json::from_str(&html[start..end]).unwrap()
+    }
+
+    #[test]
+    fn a_timed_trajectory_plays_at_its_own_times_thinned_to_the_sample_rate() {
+        let problem = parse_problem(include_str!("../../examples/wall.json")).unwrap();
+        let (a, b) = (problem.start, [0.3, -0.5, 0.1, -2.0, 0.0, 1.6, 0.9]);
+        // 1 kHz over 1.5 s: thinned to every 20th point (50 per second) and the last.
+        let trajectory: Vec<(f32, Joints<f32>)> = (0..=1500)
+            .map(|k| {
+                let s = k as f32 / 1500.0;
+                (k as f32 / 1000.0, core::array::from_fn(|j| a[j] + s * (b[j] - a[j])))
+            })
+            .collect();
+        let plan = PlanDocument {
+            status: "success".to_string(),
+            stage: Some("diffusion".to_string()),
+            waypoints: vec![a, b],
+            trajectory: trajectory.clone(),
+            candidates: Vec::new(),
+            timing_ms: vec![("total".to_string(), 2.0)],
+        };
+        let data = embedded_data(&page(&problem, Some(&plan), "t</script>").unwrap());
+        let times: Vec<f64> = serde_json::from_value(data["samples"]["times"].clone()).unwrap();
+        assert_eq!(times.len(), 76);
+        assert_eq!((times[0], times[1], times[75]), (0.0, 0.02, 1.5));
+        assert_eq!(data["title"], "t</script>");
+        // Each sample is the core's FK of its trajectory point: 13 frames, the TCP as its own.
+        let k = forward_with(&trajectory[1500].1, problem.scene.gripper()).unwrap();
+        let tcp: [f64; 3] = serde_json::from_value(data["samples"]["tcp"][75].clone()).unwrap();
+        let poses: Vec<f64> = serde_json::from_value(data["samples"]["poses"][75].clone()).unwrap();
+        assert_eq!(poses.len(), 7 * FRAMES);
+        for c in 0..3 {
+            assert!((tcp[c] - f64::from(k.tcp().translation[c])).abs() < 1e-6);
+            assert_eq!(poses[7 * TCP_FRAME + c], tcp[c]);
+        }
+    }
 }
