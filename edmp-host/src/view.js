@@ -274,6 +274,9 @@ showCandidates.addEventListener("change", () => {
   candidateGroup.visible = showCandidates.checked;
   render();
 });
+// A scene without a plan has nothing to play.
+playButton.disabled = duration === 0;
+slider.disabled = duration === 0;
 controls.addEventListener("change", render);
 window.addEventListener("hashchange", fromHash);
 window.addEventListener("resize", () => {
