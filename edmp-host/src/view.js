@@ -122,6 +122,11 @@ if (points.length > 1) {
   const tube = new THREE.TubeGeometry(curve, Math.min(4 * points.length, 800), 0.004, 8, false);
   pathGroup.add(new THREE.Mesh(tube, new THREE.MeshBasicMaterial({ color: 0x9a0d0d })));
 }
+// The plan's waypoints: a dot at each one's TCP.
+const dots = new THREE.BufferGeometry().setFromPoints(
+  data.waypoints_tcp.map((p) => new THREE.Vector3(p[0], p[1], p[2])),
+);
+pathGroup.add(new THREE.Points(dots, new THREE.PointsMaterial({ color: 0x5c0808, size: 5, sizeAttenuation: false })));
 const CANDIDATE_COLOURS = [0x1f77b4, 0x2ca02c, 0x9467bd, 0xe377c2, 0x17becf, 0xbcbd22];
 const candidateGroup = new THREE.Group();
 candidateGroup.visible = false;

@@ -179,7 +179,8 @@ fn escape_html(text: &str) -> String {
     text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
 
-/// Rounded to the micrometre (or microsecond): enough for the page, a third of the digits.
+/// Rounded to the micrometre (or microsecond): enough for the page, and shorter text than the
+/// shortest round-trip form of an `f32`.
 fn micro(x: f32) -> f64 {
     (f64::from(x) * 1e6).round() / 1e6
 }
@@ -273,6 +274,10 @@ fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Res
         Goal::Joints(q) => sample(&q, finger, "goal.joints")?.1,
         Goal::Pose { position, .. } => position.map(micro),
     };
+    let waypoints_tcp = match plan {
+        Some(plan) => tcp_path(&plan.waypoints, finger, "waypoints")?,
+        None => Vec::new(),
+    };
     let candidates = match plan {
         Some(plan) => plan
             .candidates
@@ -309,6 +314,7 @@ fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Res
         "samples": {"times": times, "poses": poses, "tcp": tcp},
         "start_tcp": start_tcp,
         "goal_tcp": goal_tcp,
+        "waypoints_tcp": waypoints_tcp,
         "candidates": candidates,
         "info": info,
     }))
