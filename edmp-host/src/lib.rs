@@ -22,6 +22,7 @@ mod scenes;
 pub mod suite;
 pub mod threads;
 pub mod timed;
+pub mod view;
 
 /// What went wrong, and the exit status it maps to (`spec/formats.md`).
 #[derive(Debug)]

@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 use edmp_host::{
     Failure, bench, bench_report, bench_rrt, embed, fk, gen_data, moveit, plan_cmd, render, rrt_cmd, sample, suite,
+    view,
 };
 use std::process::ExitCode;
 
@@ -41,6 +42,8 @@ enum Command {
     Embed(embed::Args),
     /// Convert a MoveIt planning scene (and motion plan request) YAML to `edmp-scene/1` JSON.
     ImportMoveit(moveit::Args),
+    /// Write an interactive 3-D viewer of a scene (and a plan) as one self-contained HTML page.
+    View(view::Args),
 }
 
 fn main() -> ExitCode {
@@ -58,6 +61,7 @@ fn main() -> ExitCode {
         Command::Sample(args) => sample::run(&args).map_err(Failure::Input),
         Command::Embed(args) => embed::run(&args),
         Command::ImportMoveit(args) => moveit::run(&args),
+        Command::View(args) => view::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

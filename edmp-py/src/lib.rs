@@ -11,7 +11,7 @@ use edmp_core::planner::{Judging, PlanConfig};
 use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS};
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;
-use edmp_host::json::{Goal, Problem, joint_goal, parse_problem};
+use edmp_host::json::{Goal, Problem, joint_goal, parse_plan, parse_problem};
 use edmp_host::plan_cmd::{add_trajectory, chosen_guides, plan_document, plan_problem};
 use edmp_host::timed::TimedRequest;
 use pyo3::create_exception;
@@ -228,9 +228,23 @@ fn import_moveit(scene_yaml: &str, request_yaml: Option<&str>) -> PyResult<Strin
     to_json(&doc)
 }
 
+/// The viewer page of `edmp-host view` (one self-contained HTML document) for a scene and
+/// optionally a plan (`edmp-plan/1` JSON text); raises `SceneError` for the scene and
+/// `ValueError` for the plan, naming the JSON path.
+#[pyfunction]
+#[pyo3(signature = (scene, plan = None, title = "edmp"))]
+fn view_page(scene: &str, plan: Option<&str>, title: &str) -> PyResult<String> {
+    let problem = parse(scene)?;
+    let plan = match plan {
+        Some(text) => Some(parse_plan(text).map_err(|e| PyValueError::new_err(format!("plan: {e}")))?),
+        None => None,
+    };
+    edmp_host::view::page(&problem, plan.as_ref(), title).map_err(PlanError::new_err)
+}
+
 /// The native half of `edmp` (use the `edmp` package).
 #[pymodule]
 mod _edmp {
     #[pymodule_export]
-    use super::{PlanError, SceneError, check, fk, ik, import_moveit, plan, plan_problem_ms, validate};
+    use super::{PlanError, SceneError, check, fk, ik, import_moveit, plan, plan_problem_ms, validate, view_page};
 }

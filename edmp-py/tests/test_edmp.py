@@ -232,3 +232,68 @@ def test_the_gripper_opening_is_part_of_the_problem() -> None:
         edmp.plan(edmp.Scene.from_dict(closed), seed=0)
     with pytest.raises(edmp.SceneError, match=r"gripper\.finger"):
         edmp.Scene.from_dict({**grasp, "gripper": {"finger": 0.05}})
+
+
+def _page_data(page: str) -> dict:
+    """The JSON the viewer page embeds (poses, meshes, paths, report)."""
+    start = page.index('<script type="application/json" id="edmp-data">')
+    start = page.index(">", start) + 1
+    return json.loads(page[start : page.index("</script>", start)])
+
+
+def test_show_writes_the_viewer_page_and_opens_it(
+    wall: edmp.Scene, wall_plan: edmp.Plan, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    opened: list[str] = []
+    monkeypatch.setattr("webbrowser.open", lambda url: opened.append(url) or True)
+    monkeypatch.setattr(edmp, "_in_notebook", lambda: False)
+    target = tmp_path / "plan.html"
+    assert edmp.show(wall, wall_plan, path=target) == target.resolve()
+    assert opened == [target.resolve().as_uri()]
+    page = target.read_text(encoding="utf-8")
+    assert page.startswith("<!DOCTYPE html>") and "<script src" not in page
+    data = _page_data(page)
+    # Untimed: one sample per waypoint, the first at the start; every candidate's TCP path.
+    assert len(data["samples"]["times"]) == 50
+    np.testing.assert_allclose(data["samples"]["tcp"][0], edmp.fk(wall.start)["tcp"]["position"], atol=1e-5)
+    assert len(data["candidates"]) == len(wall_plan.candidates or [])
+    assert data["info"]["status"] == "success"
+    # A scene alone: the arm at the start, written to a temporary file.
+    alone = edmp.show(wall)
+    assert opened[-1] == alone.as_uri() and len(_page_data(alone.read_text())["samples"]["times"]) == 1
+    alone.unlink()
+
+
+def test_show_names_the_bad_plan_field(wall: edmp.Scene, wall_plan: edmp.Plan, tmp_path: Path) -> None:
+    doc = dict(wall_plan.document)
+    doc["waypoints"] = [list(w) for w in doc["waypoints"]]
+    doc["waypoints"][1] = doc["waypoints"][1][:6]
+    with pytest.raises(ValueError, match=r"plan: waypoints\[1\]: expected 7 numbers, found 6"):
+        edmp.show(wall, doc, path=tmp_path / "bad.html")
+    assert not (tmp_path / "bad.html").exists()
+
+
+def test_show_returns_an_inline_page_in_jupyter(
+    wall: edmp.Scene, wall_plan: edmp.Plan, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pytest.importorskip("IPython")
+    monkeypatch.setattr(edmp, "_in_notebook", lambda: True)
+    shown = edmp.show(wall, wall_plan)
+    assert type(shown).__name__ == "HTML" and shown.data.startswith("<div><iframe srcdoc=")
+    assert "edmp-data" in shown.data and "<script" not in shown.data  # the page is escaped
+
+
+@pytest.mark.skipif(HOST is None, reason="EDMP_HOST (the edmp-host binary) not set")
+def test_show_draws_what_the_cli_view_draws(
+    wall: edmp.Scene, wall_plan: edmp.Plan, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr("webbrowser.open", lambda url: True)
+    monkeypatch.setattr(edmp, "_in_notebook", lambda: False)
+    plan_file = tmp_path / "plan.json"
+    plan_file.write_text(json.dumps(wall_plan.document))
+    cli = tmp_path / "cli.html"
+    subprocess.run([HOST, "view", str(WALL), str(plan_file), "-o", str(cli)], check=True)
+    ours = _page_data(edmp.show(wall, wall_plan, path=tmp_path / "py.html").read_text())
+    theirs = _page_data(cli.read_text())
+    assert ours.pop("title") == "edmp plan" and theirs.pop("title") == "wall.json — plan.json"
+    assert ours == theirs

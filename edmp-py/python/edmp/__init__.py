@@ -14,9 +14,13 @@ CLI's ``edmp-plan/1`` document, parsed.
 
 from __future__ import annotations
 
+import html
 import json
 import os
+import tempfile
+import webbrowser
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Mapping, Optional, Sequence, Union
 
 import numpy as np
@@ -38,6 +42,7 @@ __all__ = [
     "ik",
     "import_moveit",
     "plan",
+    "show",
 ]
 
 Array = npt.NDArray[np.float64]
@@ -344,3 +349,55 @@ def import_moveit(
 
     doc = _edmp.import_moveit(text(scene_yaml), None if request_yaml is None else text(request_yaml))
     return Scene.from_json(doc)
+
+
+def _in_notebook() -> bool:
+    """Whether this runs in a Jupyter kernel (IPython's ZMQ shell)."""
+    try:
+        from IPython import get_ipython  # type: ignore[import-not-found]
+    except ImportError:
+        return False
+    shell = get_ipython()
+    return shell is not None and type(shell).__name__ == "ZMQInteractiveShell"
+
+
+def show(
+    scene: Union[Scene, Mapping[str, Any], str],
+    plan: Union[Plan, Mapping[str, Any], str, None] = None,
+    path: Union[str, os.PathLike[str], None] = None,
+) -> Any:
+    """Shows the scene (and the plan, animated) in the interactive 3-D viewer of
+    ``edmp-host view`` (docs/viewer.md): one self-contained HTML page, written by the same
+    Rust code. ``plan`` is a :class:`Plan`, its document as a dict, or its JSON text.
+
+    Inside Jupyter it returns an ``IPython.display.HTML`` object that shows the page inline
+    (and writes it to ``path`` too when given). Elsewhere it writes the page to ``path`` (a
+    temporary file when ``None``), opens it in the web browser and returns its path.
+    Invalid input raises :class:`SceneError` (scene) or ``ValueError`` (plan) naming the field.
+    """
+    if plan is None:
+        plan_text = None
+    elif isinstance(plan, Plan):
+        plan_text = json.dumps(plan.document)
+    elif isinstance(plan, str):
+        plan_text = plan
+    else:
+        plan_text = json.dumps(dict(plan))
+    title = "edmp plan" if plan is not None else "edmp scene"
+    page = _edmp.view_page(_scene_text(scene), plan_text, title)
+    if path is not None:
+        Path(path).write_text(page, encoding="utf-8")
+    if _in_notebook():
+        from IPython.display import HTML  # type: ignore[import-not-found]
+
+        # In its own document (srcdoc), so the page's scripts do not meet the notebook's.
+        frame = f'<iframe srcdoc="{html.escape(page, quote=True)}" style="width: 100%; height: 600px; border: 0"></iframe>'
+        return HTML(f"<div>{frame}</div>")
+    if path is None:
+        handle, name = tempfile.mkstemp(prefix="edmp-view-", suffix=".html")
+        with os.fdopen(handle, "w", encoding="utf-8") as f:
+            f.write(page)
+        path = name
+    target = Path(path).resolve()
+    webbrowser.open(target.as_uri())
+    return target
