@@ -160,7 +160,7 @@ pub(crate) fn lines(
 }
 
 /// Distributions of planning times: per series, the share of problems planned within each time
-/// (steps from [`crate::bench::cdf`]), the time axis up to the slowest plan.
+/// (steps from [`crate::commands::bench::cdf`]), the time axis up to the slowest plan.
 pub(crate) fn time_distribution(path: &Path, title: &str, curves: &[(String, Vec<(f64, f64)>)]) -> Result<(), String> {
     let t_max = curves
         .iter()

@@ -73,7 +73,7 @@ fn the_opening_travels_in_the_firmwares_postcard_bytes() {
     use edmp_core::wire::Problem;
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let text = std::fs::read_to_string(root.join("examples/grasp-can.json")).unwrap();
-    let problem = edmp_host::embed::wire_problem(&text, 5).unwrap();
+    let problem = edmp_host::commands::embed::wire_problem(&text, 5).unwrap();
     assert_eq!(problem.finger, 0.04);
     let bytes = postcard::to_stdvec(&problem).unwrap();
     let back: Problem<MAX_OBSTACLES> = postcard::from_bytes(&bytes).unwrap();
@@ -82,9 +82,15 @@ fn the_opening_travels_in_the_firmwares_postcard_bytes() {
     assert_eq!(scene.gripper(), 0.04);
     assert_eq!(
         scene.obstacles(),
-        edmp_host::json::parse_problem(&text).unwrap().scene.obstacles()
+        edmp_host::formats::json::parse_problem(&text)
+            .unwrap()
+            .scene
+            .obstacles()
     );
     // A scene without the field travels at the default opening.
     let wall = std::fs::read_to_string(root.join("examples/wall.json")).unwrap();
-    assert_eq!(edmp_host::embed::wire_problem(&wall, 0).unwrap().finger, 0.025);
+    assert_eq!(
+        edmp_host::commands::embed::wire_problem(&wall, 0).unwrap().finger,
+        0.025
+    );
 }

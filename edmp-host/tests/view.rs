@@ -5,8 +5,8 @@
 //! it the test prints a note and skips, except under CI (`CI=true`), where it fails.
 
 use edmp_core::robot::kinematics::forward_with;
-use edmp_host::json::{parse_plan, parse_problem};
-use edmp_host::view::EVEN_STEP_S;
+use edmp_host::commands::view::EVEN_STEP_S;
+use edmp_host::formats::json::{parse_plan, parse_problem};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

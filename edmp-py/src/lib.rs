@@ -1,8 +1,8 @@
 //! `edmp._edmp`: the native half of the `edmp` Python package. Every function takes and returns
 //! plain values or JSON text; the typed, numpy-facing API is `python/edmp/__init__.py`.
 //!
-//! Scenes go through the host's one reader of `edmp-scene/1` (`edmp_host::json`), plans through
-//! its planner driver and its one writer of `edmp-plan/1` (`edmp_host::plan_cmd`), so a plan
+//! Scenes go through the host's one reader of `edmp-scene/1` (`edmp_host::formats::json`), plans through
+//! its planner driver and its one writer of `edmp-plan/1` (`edmp_host::commands::plan`), so a plan
 //! from Python is the CLI's document. Planning releases the GIL.
 
 use edmp_core::collision::checker::{CheckConfig, Contact, check_trajectory};
@@ -11,9 +11,9 @@ use edmp_core::planner::{Judging, PlanConfig};
 use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS};
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;
-use edmp_host::json::{Goal, Problem, joint_goal, parse_plan, parse_problem};
-use edmp_host::plan_cmd::{add_trajectory, chosen_guides, plan_document, plan_problem};
-use edmp_host::timed::TimedRequest;
+use edmp_host::commands::plan::{add_trajectory, chosen_guides, plan_document, plan_problem};
+use edmp_host::formats::json::{Goal, Problem, joint_goal, parse_plan, parse_problem};
+use edmp_host::formats::trajectory::TimedRequest;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -153,7 +153,7 @@ fn joints_of(q: &[f64], what: &str) -> PyResult<[f32; JOINTS]> {
 #[pyfunction]
 fn fk(q: Vec<f64>) -> PyResult<String> {
     let q = joints_of(&q, "q")?;
-    let doc = edmp_host::fk::document(&q).map_err(|e| PyValueError::new_err(format!("q: {e}")))?;
+    let doc = edmp_host::commands::fk::document(&q).map_err(|e| PyValueError::new_err(format!("q: {e}")))?;
     to_json(&doc)
 }
 
@@ -224,7 +224,7 @@ fn ik(scene: &str, position: Vec<f64>, quaternion: Vec<f64>) -> PyResult<Option<
 #[pyfunction]
 #[pyo3(signature = (scene_yaml, request_yaml = None))]
 fn import_moveit(scene_yaml: &str, request_yaml: Option<&str>) -> PyResult<String> {
-    let (doc, _) = edmp_host::moveit::import_validated(scene_yaml, request_yaml).map_err(scene_error)?;
+    let (doc, _) = edmp_host::formats::moveit::import_validated(scene_yaml, request_yaml).map_err(scene_error)?;
     to_json(&doc)
 }
 
@@ -239,7 +239,7 @@ fn view_page(scene: &str, plan: Option<&str>, title: &str) -> PyResult<String> {
         Some(text) => Some(parse_plan(text).map_err(|e| PyValueError::new_err(format!("plan: {e}")))?),
         None => None,
     };
-    edmp_host::view::page(&problem, plan.as_ref(), title).map_err(PlanError::new_err)
+    edmp_host::commands::view::page(&problem, plan.as_ref(), title).map_err(PlanError::new_err)
 }
 
 /// The native half of `edmp` (use the `edmp` package).

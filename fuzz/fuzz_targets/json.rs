@@ -1,10 +1,10 @@
-//! Arbitrary bytes through the host's one reader of `edmp-scene/1` (`edmp_host::json`), which
+//! Arbitrary bytes through the host's one reader of `edmp-scene/1` (`edmp_host::formats::json`), which
 //! the CLI and the Python package share. It must never panic: the result is either a problem
 //! whose ends are finite and whose obstacles fit the scene's capacity, or an error message
 //! (the JSON path of the bad field and why).
 #![no_main]
 
-use edmp_host::json::{Goal, parse_problem};
+use edmp_host::formats::json::{Goal, parse_problem};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

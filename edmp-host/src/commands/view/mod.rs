@@ -8,7 +8,7 @@
 //! at those poses and interpolates between samples; it computes no kinematics.
 
 use crate::Failure;
-use crate::json::{Goal, PlanDocument, Problem, parse_plan, parse_problem};
+use crate::formats::json::{Goal, PlanDocument, Problem, parse_plan, parse_problem};
 use edmp_core::robot::kinematics::{Joints, Pose, forward_with};
 use edmp_core::robot::{FRAME_NAMES, FRAMES, HAND_FRAME, TCP_FRAME};
 use edmp_core::scene::{Obstacle, Shape};
@@ -29,71 +29,71 @@ pub struct Args {
 }
 
 /// The Panda's URDF: the visual meshes and their origins come from its `<visual>` elements.
-const URDF: &str = include_str!("../../weights/panda/panda.urdf");
+const URDF: &str = include_str!("../../../../weights/panda/panda.urdf");
 
 /// The mesh files the URDF's visuals name, by their `package://` path: the OBJ text and its
 /// MTL text (empty when the mesh has no colours of its own).
 const MESH_FILES: [(&str, &str, &str); 10] = [
     (
         "meshes/collision/link0.obj",
-        include_str!("../../weights/panda/meshes/collision/link0.obj"),
+        include_str!("../../../../weights/panda/meshes/collision/link0.obj"),
         "",
     ),
     (
         "meshes/visual/link1.obj",
-        include_str!("../../weights/panda/meshes/visual/link1.obj"),
-        include_str!("../../weights/panda/meshes/visual/link1.mtl"),
+        include_str!("../../../../weights/panda/meshes/visual/link1.obj"),
+        include_str!("../../../../weights/panda/meshes/visual/link1.mtl"),
     ),
     (
         "meshes/visual/link2.obj",
-        include_str!("../../weights/panda/meshes/visual/link2.obj"),
-        include_str!("../../weights/panda/meshes/visual/link2.mtl"),
+        include_str!("../../../../weights/panda/meshes/visual/link2.obj"),
+        include_str!("../../../../weights/panda/meshes/visual/link2.mtl"),
     ),
     (
         "meshes/visual/link3.obj",
-        include_str!("../../weights/panda/meshes/visual/link3.obj"),
-        include_str!("../../weights/panda/meshes/visual/link3.mtl"),
+        include_str!("../../../../weights/panda/meshes/visual/link3.obj"),
+        include_str!("../../../../weights/panda/meshes/visual/link3.mtl"),
     ),
     (
         "meshes/visual/link4.obj",
-        include_str!("../../weights/panda/meshes/visual/link4.obj"),
-        include_str!("../../weights/panda/meshes/visual/link4.mtl"),
+        include_str!("../../../../weights/panda/meshes/visual/link4.obj"),
+        include_str!("../../../../weights/panda/meshes/visual/link4.mtl"),
     ),
     (
         "meshes/visual/link5.obj",
-        include_str!("../../weights/panda/meshes/visual/link5.obj"),
-        include_str!("../../weights/panda/meshes/visual/link5.mtl"),
+        include_str!("../../../../weights/panda/meshes/visual/link5.obj"),
+        include_str!("../../../../weights/panda/meshes/visual/link5.mtl"),
     ),
     (
         "meshes/visual/link6.obj",
-        include_str!("../../weights/panda/meshes/visual/link6.obj"),
-        include_str!("../../weights/panda/meshes/visual/link6.mtl"),
+        include_str!("../../../../weights/panda/meshes/visual/link6.obj"),
+        include_str!("../../../../weights/panda/meshes/visual/link6.mtl"),
     ),
     (
         "meshes/collision/link7.obj",
-        include_str!("../../weights/panda/meshes/collision/link7.obj"),
+        include_str!("../../../../weights/panda/meshes/collision/link7.obj"),
         "",
     ),
     (
         "meshes/visual/hand.obj",
-        include_str!("../../weights/panda/meshes/visual/hand.obj"),
-        include_str!("../../weights/panda/meshes/visual/hand.mtl"),
+        include_str!("../../../../weights/panda/meshes/visual/hand.obj"),
+        include_str!("../../../../weights/panda/meshes/visual/hand.mtl"),
     ),
     (
         "meshes/visual/finger.obj",
-        include_str!("../../weights/panda/meshes/visual/finger.obj"),
-        include_str!("../../weights/panda/meshes/visual/finger.mtl"),
+        include_str!("../../../../weights/panda/meshes/visual/finger.obj"),
+        include_str!("../../../../weights/panda/meshes/visual/finger.mtl"),
     ),
 ];
 
 /// The page around the data and the scripts.
-const TEMPLATE: &str = include_str!("view.html");
+const TEMPLATE: &str = include_str!("page.html");
 /// The page's own script: builds the three.js scene from the embedded data.
-const APP_JS: &str = include_str!("view.js");
+const APP_JS: &str = include_str!("page.js");
 /// three.js 0.170.0 (npm `three`, MIT), unmodified.
-const THREE_JS: &str = include_str!("../vendor/three/three.module.min.js");
+const THREE_JS: &str = include_str!("../../../vendor/three/three.module.min.js");
 /// three.js's OrbitControls, from the same package.
-const ORBIT_JS: &str = include_str!("../vendor/three/OrbitControls.js");
+const ORBIT_JS: &str = include_str!("../../../vendor/three/OrbitControls.js");
 
 /// Colour of a mesh whose file names none (the URDF's `panda_white`).
 const DEFAULT_COLOUR: [f32; 3] = [0.9, 0.9, 0.9];
@@ -543,7 +543,7 @@ mod tests {
 
     #[test]
     fn a_timed_trajectory_plays_at_its_own_times_thinned_to_the_sample_rate() {
-        let problem = parse_problem(include_str!("../../examples/wall.json")).unwrap();
+        let problem = parse_problem(include_str!("../../../../examples/wall.json")).unwrap();
         let (a, b) = (problem.start, [0.3, -0.5, 0.1, -2.0, 0.0, 1.6, 0.9]);
         // 1 kHz over 1.5 s: thinned to every 20th point (50 per second) and the last.
         let trajectory: Vec<(f32, Joints<f32>)> = (0..=1500)

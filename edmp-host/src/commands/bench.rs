@@ -7,9 +7,9 @@
 //! - `success.png` (success per family) and `time.png` (distribution of planning times).
 
 use crate::Failure;
-use crate::json::{Goal, parse_problem};
+use crate::commands::plan::{Tuning, chosen_guides, plan_problem_on};
+use crate::formats::json::{Goal, parse_problem};
 use crate::metrics::{Roughness, acsm, path_length, roughness};
-use crate::plan_cmd::{Tuning, chosen_guides, plan_problem_on};
 use crate::plots;
 use core::time::Duration;
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
@@ -218,7 +218,7 @@ fn run_rrt(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
     let parsed = parse_problem(text).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
     let goal = match parsed.goal {
         Goal::Joints(q) => q,
-        Goal::Pose { .. } => crate::json::joint_goal(&parsed).map_err(Failure::Input)?,
+        Goal::Pose { .. } => crate::formats::json::joint_goal(&parsed).map_err(Failure::Input)?,
     };
     let config = crate::rrt::RrtConfig {
         budget: Duration::from_millis(args.budget_ms),
@@ -322,7 +322,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     args.tuning.config()?;
     let label = label(args, &guides);
-    let folders = crate::suite::read_folder(&args.problems, args.per_family).map_err(input)?;
+    let folders = crate::commands::gen_suite::read_folder(&args.problems, args.per_family).map_err(input)?;
     let jobs: Vec<(String, PathBuf)> = folders
         .iter()
         .flat_map(|(family, files)| files.iter().map(move |f| (family.clone(), f.clone())))

@@ -6,7 +6,7 @@
 //! colour per collision-free candidate, grey for colliding ones.
 //! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
 
-use crate::json::{Goal, parse_problem};
+use crate::formats::json::{Goal, parse_problem};
 use edmp_core::collision::convex::{Convex, Primitive};
 use edmp_core::robot::kinematics::{Joints, forward, forward_with};
 use edmp_core::robot::{BODIES, PANDA};

@@ -2,7 +2,7 @@
 //! one row per family: success within the budget, median and p95 planning time, mean path
 //! length (joint space, radians), as a Markdown table on standard output.
 
-use crate::json::{Goal, parse_problem};
+use crate::formats::json::{Goal, parse_problem};
 use crate::rrt::{RrtConfig, path_length, plan};
 use core::time::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -58,7 +58,7 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 
 /// Runs the benchmark and prints the table.
 pub fn run(args: &Args) -> Result<(), String> {
-    let families = crate::suite::read_folder(&args.problems, usize::MAX)?;
+    let families = crate::commands::gen_suite::read_folder(&args.problems, usize::MAX)?;
     let budget = Duration::from_millis(args.budget_ms);
     println!(
         "| family | solved (≤ {} ms) | median time (ms) | p95 time (ms) | mean path length (rad) |",

@@ -175,7 +175,7 @@ fn family_offset(family: Family) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::json::{Goal, parse_problem};
+    use crate::formats::json::{Goal, parse_problem};
 
     const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../benchmarks/problems");
     const UNSEEN_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../benchmarks/unseen");

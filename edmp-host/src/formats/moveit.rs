@@ -1,6 +1,6 @@
-//! `edmp-host import-moveit`: a MoveIt planning scene (`moveit_msgs/PlanningScene` as YAML, e.g.
+//! MoveIt's planning scenes as `edmp-scene/1`: a `moveit_msgs/PlanningScene` as YAML (e.g.
 //! from `rostopic echo` / `ros2 topic echo`) and optionally a `moveit_msgs/MotionPlanRequest`
-//! (YAML) as one `edmp-scene/1` document, validated through the host's JSON reader.
+//! (YAML) become one document, validated through the host's JSON reader.
 //!
 //! What is read: `world.collision_objects[]` (BOX, SPHERE, CYLINDER primitives; the world pose
 //! of each is the object's `pose` times the primitive's pose), one object attached to
@@ -17,15 +17,13 @@
 //! colours, planner settings, the allowed collision matrix, which only ever permits contacts)
 //! are ignored. Unknown fields are errors, as in `edmp-scene/1`.
 
-use crate::Failure;
-use crate::json::{Problem, parse_problem};
+use crate::formats::json::{Problem, parse_problem};
 use core::fmt;
 use edmp_core::robot::kinematics::forward;
 use edmp_core::robot::{FRAME_NAMES, HAND_FRAME, JOINT_NAMES, JOINTS, TCP_FRAME};
 use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
 use saphyr::{LoadableYamlNode, Scalar, Yaml};
 use serde_json::{Map, Value, json};
-use std::path::PathBuf;
 
 /// The finger opening `edmp-scene/1` holds when it has no `gripper` field (metres).
 const FINGER_OPENING: f64 = 0.025;
@@ -911,46 +909,4 @@ pub fn import_validated(scene_yaml: &str, request_yaml: Option<&str>) -> Result<
     let problem =
         parse_problem(&doc.to_string()).map_err(|e| format!("the imported edmp-scene/1 is not valid: {e}"))?;
     Ok((doc, problem))
-}
-
-/// Arguments of `edmp-host import-moveit`.
-#[derive(Debug, clap::Args)]
-pub struct Args {
-    /// The MoveIt planning scene (`moveit_msgs/PlanningScene` as YAML).
-    #[arg(long)]
-    scene: PathBuf,
-    /// The motion plan request (`moveit_msgs/MotionPlanRequest` as YAML): start and goal.
-    #[arg(long)]
-    request: Option<PathBuf>,
-    /// Write the `edmp-scene/1` JSON here instead of standard output.
-    #[arg(short, long)]
-    output: Option<PathBuf>,
-}
-
-/// Imports, validates and writes the scene.
-pub fn run(args: &Args) -> Result<(), Failure> {
-    let read = |p: &PathBuf| std::fs::read_to_string(p).map_err(|e| Failure::Input(format!("{}: {e}", p.display())));
-    let scene = read(&args.scene)?;
-    let request = args.request.as_ref().map(read).transpose()?;
-    let doc = import(&scene, request.as_deref()).map_err(|e| {
-        let file = match (e.source, &args.request) {
-            (Source::Request, Some(r)) => r,
-            _ => &args.scene,
-        };
-        if e.path.is_empty() {
-            Failure::Input(format!("{}: {}", file.display(), e.message))
-        } else {
-            Failure::Input(format!("{}: {}: {}", file.display(), e.path, e.message))
-        }
-    })?;
-    parse_problem(&doc.to_string())
-        .map_err(|e| Failure::Input(format!("the imported edmp-scene/1 is not valid: {e}")))?;
-    let text = serde_json::to_string_pretty(&doc).map_err(|e| Failure::Input(e.to_string()))? + "\n";
-    match &args.output {
-        Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display()))),
-        None => {
-            print!("{text}");
-            Ok(())
-        }
-    }
 }

@@ -4,9 +4,9 @@
 //! nothing written.
 
 use crate::Failure;
-use crate::json::{Problem, joint_goal, parse_problem};
+use crate::formats::json::{Problem, joint_goal, parse_problem};
+use crate::formats::trajectory::{TimedArgs, TimedRequest, trajectory_document};
 use crate::threads::Threads;
-use crate::timed::{TimedArgs, TimedRequest, trajectory_document};
 use edmp_core::cost::boxes::{BoxFrame, Inflation};
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::executor::{Executor, Serial};

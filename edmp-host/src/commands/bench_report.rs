@@ -10,7 +10,7 @@
 //!   6 or 12 guides;
 //! - Figure 7: each guide's share of the ensemble's successes (`winners.png`).
 
-use crate::bench::{Record, TABLE_HEADER, cdf, families, read_results, table_row};
+use crate::commands::bench::{Record, TABLE_HEADER, cdf, families, read_results, table_row};
 use crate::plots;
 use core::fmt::Write as _;
 use std::path::PathBuf;

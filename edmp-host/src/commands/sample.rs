@@ -6,9 +6,9 @@
 //! checker, empty scene), and the sampling time. `--data` adds the same row for the training
 //! trajectories; `--plot` draws some samples, joint by joint, to a PNG.
 
-use crate::json::{Goal, parse_problem};
+use crate::commands::render::Canvas;
+use crate::formats::json::{Goal, parse_problem};
 use crate::metrics::{Roughness, roughness, step_norm};
-use crate::render::Canvas;
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::path::{HORIZON, Path};
 use edmp_core::prior::{Sampler, Scratch, sample_conditioned};
@@ -176,7 +176,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         return Err("--samplers: give at least one".into());
     }
     let mut problems = Vec::new();
-    for (_, files) in crate::suite::read_folder(&args.problems, args.per_family)? {
+    for (_, files) in crate::commands::gen_suite::read_folder(&args.problems, args.per_family)? {
         for path in files {
             let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let p = parse_problem(&text).map_err(|e| format!("{}: {e}", path.display()))?;

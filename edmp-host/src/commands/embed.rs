@@ -9,7 +9,7 @@
 //! parameterization (Franka's limits, jerk-limited) for free plans, as the firmware times it.
 
 use crate::Failure;
-use crate::json::{joint_goal, parse_problem};
+use crate::formats::json::{joint_goal, parse_problem};
 use core::fmt::Write as _;
 use edmp_core::guidance::guides::EDMP_GUIDES;
 use edmp_core::planner::{Plan, PlanConfig, Request, Workspace, plan};

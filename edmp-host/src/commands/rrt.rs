@@ -2,7 +2,7 @@
 //! `edmp-plan/1` plan (status "success" only: without a path nothing is written, exit 1).
 
 use crate::Failure;
-use crate::json::{joint_goal, parse_problem};
+use crate::formats::json::{joint_goal, parse_problem};
 use crate::rrt::{RrtConfig, RrtError, path_length, plan};
 use core::time::Duration;
 use serde_json::json;
