@@ -9,7 +9,7 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 /// Default obstacle capacity of a [`Scene`].
 pub const MAX_OBSTACLES: usize = 64;
 
-/// How far a quaternion's norm may be from 1 (`spec/formats.md`); within it, it is normalised.
+/// How far a quaternion's norm may be from 1 (docs/formats.md); within it, it is normalised.
 pub const QUATERNION_NORM_TOLERANCE: f32 = 1e-3;
 
 /// The geometry of a primitive, in its own frame (centred at the origin).
@@ -43,6 +43,61 @@ pub struct Obstacle {
     pub center: Vector3<f32>,
     /// Orientation (columns are the primitive's axes).
     pub rotation: Matrix3<f32>,
+}
+
+/// An obstacle as its parameters, as a scene file, a generator or the wire to firmware gives
+/// them (quaternions `[w, x, y, z]`, as in `edmp-scene/1`); [`Primitive::to_obstacle`]
+/// validates it into an [`Obstacle`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Primitive {
+    /// A box with full extents `dims`.
+    Cuboid {
+        /// Centre.
+        center: [f32; 3],
+        /// Full extents along the box's x, y, z.
+        dims: [f32; 3],
+        /// Orientation.
+        quaternion: [f32; 4],
+    },
+    /// A cylinder along its local z.
+    Cylinder {
+        /// Centre.
+        center: [f32; 3],
+        /// Radius.
+        radius: f32,
+        /// Full length along z.
+        height: f32,
+        /// Orientation.
+        quaternion: [f32; 4],
+    },
+    /// A ball.
+    Sphere {
+        /// Centre.
+        center: [f32; 3],
+        /// Radius.
+        radius: f32,
+    },
+}
+
+impl Primitive {
+    /// The validated obstacle ([`Obstacle::cuboid`], [`Obstacle::cylinder`], [`Obstacle::sphere`]).
+    pub fn to_obstacle(&self) -> Result<Obstacle, SceneError> {
+        match *self {
+            Self::Cuboid {
+                center,
+                dims,
+                quaternion,
+            } => Obstacle::cuboid(center, dims, quaternion),
+            Self::Cylinder {
+                center,
+                radius,
+                height,
+                quaternion,
+            } => Obstacle::cylinder(center, radius, height, quaternion),
+            Self::Sphere { center, radius } => Obstacle::sphere(center, radius),
+        }
+    }
 }
 
 /// Why an obstacle or a scene was refused.

@@ -3,64 +3,12 @@
 //! [`Scene`] holds validated obstacles (rotation matrices); the wire carries what a scene file
 //! says instead: each primitive's parameters and quaternion, the finger opening, the start, a joint goal (a pose
 //! goal is resolved on the host: the firmware runs no IK) and the seed. [`Problem::to_scene`]
-//! rebuilds the scene through the same [`Obstacle`] constructors the host uses, so both sides
+//! rebuilds the scene through the same [`Primitive::to_obstacle`] the host uses, so both sides
 //! plan on the same bits. Only with the `serde` feature.
 
 use crate::robot::kinematics::Joints;
-use crate::scene::{MAX_OBSTACLES, Obstacle, Scene, SceneError};
+use crate::scene::{MAX_OBSTACLES, Primitive, Scene, SceneError};
 use serde::{Deserialize, Serialize};
-
-/// An obstacle as its parameters (quaternions `[w, x, y, z]`, as in `edmp-scene/1`).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Primitive {
-    /// A box with full extents `dims`.
-    Cuboid {
-        /// Centre.
-        center: [f32; 3],
-        /// Full extents along the box's x, y, z.
-        dims: [f32; 3],
-        /// Orientation.
-        quaternion: [f32; 4],
-    },
-    /// A cylinder along its local z.
-    Cylinder {
-        /// Centre.
-        center: [f32; 3],
-        /// Radius.
-        radius: f32,
-        /// Full length along z.
-        height: f32,
-        /// Orientation.
-        quaternion: [f32; 4],
-    },
-    /// A ball.
-    Sphere {
-        /// Centre.
-        center: [f32; 3],
-        /// Radius.
-        radius: f32,
-    },
-}
-
-impl Primitive {
-    /// The validated obstacle ([`Obstacle::cuboid`], [`Obstacle::cylinder`], [`Obstacle::sphere`]).
-    pub fn to_obstacle(&self) -> Result<Obstacle, SceneError> {
-        match *self {
-            Self::Cuboid {
-                center,
-                dims,
-                quaternion,
-            } => Obstacle::cuboid(center, dims, quaternion),
-            Self::Cylinder {
-                center,
-                radius,
-                height,
-                quaternion,
-            } => Obstacle::cylinder(center, radius, height, quaternion),
-            Self::Sphere { center, radius } => Obstacle::sphere(center, radius),
-        }
-    }
-}
 
 /// One planning problem: obstacles (at most `N`), the held object, the finger opening, the
 /// ends and the seed.
@@ -99,6 +47,7 @@ impl<const N: usize> Problem<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Obstacle;
 
     const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
 

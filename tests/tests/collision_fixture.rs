@@ -5,6 +5,7 @@ use edmp_core::collision::checker::{
     CheckConfig, DEFAULT_MARGIN, END_MARGIN, PYBULLET_HULL_MARGIN, check_end, check_state, clearance,
 };
 use edmp_core::scene::{Obstacle, Scene};
+use edmp_host::formats::json::primitive;
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -18,7 +19,7 @@ struct Fixture {
 #[derive(Debug, Deserialize)]
 struct ObstaclePair {
     joints: [f64; 7],
-    obstacle: ObstacleJson,
+    obstacle: serde_json::Value,
     distance: f64,
     link: Option<String>,
 }
@@ -30,44 +31,11 @@ struct SelfPair {
     pair: Option<[String; 2]>,
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase")]
-enum ObstacleJson {
-    Cuboid {
-        center: [f32; 3],
-        dims: [f32; 3],
-        quaternion: [f32; 4],
-    },
-    Cylinder {
-        center: [f32; 3],
-        radius: f32,
-        height: f32,
-        quaternion: [f32; 4],
-    },
-    Sphere {
-        center: [f32; 3],
-        radius: f32,
-    },
-}
-
-impl ObstacleJson {
-    fn build(&self) -> Obstacle {
-        match *self {
-            Self::Cuboid {
-                center,
-                dims,
-                quaternion,
-            } => Obstacle::cuboid(center, dims, quaternion),
-            Self::Cylinder {
-                center,
-                radius,
-                height,
-                quaternion,
-            } => Obstacle::cylinder(center, radius, height, quaternion),
-            Self::Sphere { center, radius } => Obstacle::sphere(center, radius),
-        }
+/// A fixture obstacle, written as an `edmp-scene/1` primitive: read by the scene reader.
+fn obstacle(v: &serde_json::Value, i: usize) -> Obstacle {
+    primitive(v, &format!("obstacle_pairs[{i}].obstacle"))
+        .map(|p| p.to_obstacle().expect("validated by the reader"))
         .expect("fixture obstacles are valid")
-    }
 }
 
 fn fixture() -> Fixture {
@@ -91,7 +59,7 @@ fn obstacle_contacts_are_never_missed() {
     let (mut false_contact, mut false_contact_beyond_1cm, mut worst_hidden) = (0, 0, 0.0f32);
     for (i, pair) in f.obstacle_pairs.iter().enumerate() {
         let mut scene = Scene::<1>::new();
-        scene.push(pair.obstacle.build()).unwrap();
+        scene.push(obstacle(&pair.obstacle, i)).unwrap();
         let q = q32(&pair.joints);
         let ours = check_state(&scene, &q, &cfg).unwrap();
         if pair.distance <= 0.0 {
@@ -166,7 +134,7 @@ fn ends_follow_pybullets_own_rule() {
     let (mut near_free, mut refused, mut widest) = (0, 0, 0.0f64);
     for (i, pair) in f.obstacle_pairs.iter().enumerate() {
         let mut scene = Scene::<1>::new();
-        scene.push(pair.obstacle.build()).unwrap();
+        scene.push(obstacle(&pair.obstacle, i)).unwrap();
         let q = q32(&pair.joints);
         let ours = check_end(&scene, &q, &cfg).unwrap();
         if pair.distance <= 0.0 {

@@ -12,7 +12,7 @@
 //! neighbours (link7, hand, fingers and held object form one rigid group), at every waypoint
 //! and at every state of the linear joint interpolation in steps of at most `max_step`.
 
-use crate::collision::convex::{Hull, Primitive};
+use crate::collision::convex::{Hull, Solid};
 use crate::collision::gjk::{apart_by, distance_lower_bound};
 use crate::error::Error;
 use crate::robot::kinematics::{Joints, Kinematics, forward_with};
@@ -164,7 +164,7 @@ pub(crate) fn moves(body: usize) -> bool {
     body >= BODIES || PANDA.bodies[body].frame != 0
 }
 
-const PLACEHOLDER: Primitive = Primitive {
+const PLACEHOLDER: Solid = Solid {
     shape: Shape::Sphere { radius: 0.0 },
     rotation: Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
     center: Vector3::new(0.0, 0.0, 0.0),
@@ -173,7 +173,7 @@ const PLACEHOLDER: Primitive = Primitive {
 /// One state's shapes, placed.
 struct Placed<'a> {
     k: &'a Kinematics<f32>,
-    held: Option<Primitive>,
+    held: Option<Solid>,
     /// Obstacle clearance for this state.
     margin: f32,
     /// Clearance between robot bodies.
@@ -181,10 +181,10 @@ struct Placed<'a> {
 }
 
 impl Placed<'_> {
-    fn obb(&self, b: usize) -> Primitive {
+    fn obb(&self, b: usize) -> Solid {
         // `% BODIES`: callers pass robot bodies only; the modulo keeps the index provably in range.
         let b = b % BODIES;
-        Primitive::cuboid(&self.k.boxes[b], &PANDA.bodies[b].half_extents)
+        Solid::cuboid(&self.k.boxes[b], &PANDA.bodies[b].half_extents)
     }
 
     fn hull(&self, b: usize) -> Hull<'_> {
@@ -197,7 +197,7 @@ impl Placed<'_> {
 
     /// Body `b` (robot or held) proven apart from primitive `p`: the certified gap (above the
     /// margin), `None` when it is not proven.
-    fn body_apart_from(&self, b: usize, p: &Primitive, hint: &mut Vector3<f32>) -> Option<f32> {
+    fn body_apart_from(&self, b: usize, p: &Solid, hint: &mut Vector3<f32>) -> Option<f32> {
         if b >= BODIES {
             return match &self.held {
                 Some(h) => apart_by(h, p, self.margin, hint),
@@ -311,7 +311,7 @@ impl<const N: usize> Slack<N> {
 struct Prepared<'s, const N: usize> {
     scene: &'s Scene<N>,
     config: CheckConfig,
-    obstacles: [Primitive; N],
+    obstacles: [Solid; N],
     obstacle_radius: [f32; N],
     shapes: usize,
     radius: [f32; SLOTS],
@@ -326,18 +326,18 @@ struct Prepared<'s, const N: usize> {
 impl<'s, const N: usize> Prepared<'s, N> {
     fn new(scene: &'s Scene<N>, config: &CheckConfig) -> Result<Self, Error> {
         validate(config)?;
-        let obstacles: [Primitive; N] =
-            core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Primitive::obstacle));
+        let obstacles: [Solid; N] =
+            core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Solid::obstacle));
         let obstacle_radius = obstacles.map(|o| o.bounding_radius());
         let shapes = if scene.held().is_some() { SLOTS } else { BODIES };
         let radius = core::array::from_fn(|b| match (PANDA.bodies.get(b), scene.held()) {
             (Some(body), _) => crate::float::sqrt(body.half_extents.norm_squared()),
-            (None, Some(h)) => Primitive::obstacle(h).bounding_radius(),
+            (None, Some(h)) => Solid::obstacle(h).bounding_radius(),
             (None, None) => 0.0,
         });
         // The held object's points lie within |centre| + its ball's radius of the hand's origin.
         let held_extent = scene.held().map_or(0.0, |h| {
-            (crate::float::sqrt(h.center.norm_squared()) + Primitive::obstacle(h).bounding_radius()) * (1.0 + 1e-5)
+            (crate::float::sqrt(h.center.norm_squared()) + Solid::obstacle(h).bounding_radius()) * (1.0 + 1e-5)
         });
         let reach = core::array::from_fn(|b| match BODY_REACH.get(b) {
             Some(r) => *r,
@@ -411,7 +411,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
         let self_margin = self.config.self_margin;
         let carry = self.config.margin.max(self.config.end_margin) + CARRY_SLACK;
         let carry_self = self_margin + CARRY_SLACK;
-        let held = self.scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME]));
+        let held = self.scene.held().map(|h| Solid::attached(h, &k.frames[HAND_FRAME]));
         let center: [Vector3<f32>; SLOTS] = core::array::from_fn(|b| match (k.boxes.get(b), &held) {
             (Some(pose), _) => pose.translation,
             (None, Some(h)) => h.center,
@@ -509,9 +509,9 @@ pub fn check_end<const N: usize>(
 /// diagnostics and for choosing among states that are all free.
 pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f32, Error> {
     let k = forward_with(q, scene.gripper())?;
-    let held = scene.held().map(|h| Primitive::attached(h, &k.frames[HAND_FRAME]));
+    let held = scene.held().map(|h| Solid::attached(h, &k.frames[HAND_FRAME]));
     let mut best = f32::INFINITY;
-    for o in scene.obstacles().iter().map(Primitive::obstacle) {
+    for o in scene.obstacles().iter().map(Solid::obstacle) {
         for b in (0..BODIES).filter(|&b| moves(b)) {
             let hull = Hull {
                 pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],

@@ -48,7 +48,7 @@ impl Convex for Hull<'_> {
 
 /// A solid primitive placed in the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Primitive {
+pub struct Solid {
     /// The geometry.
     pub shape: Shape,
     /// Orientation.
@@ -57,7 +57,7 @@ pub struct Primitive {
     pub center: Vector3<f32>,
 }
 
-impl Primitive {
+impl Solid {
     /// An obstacle as it stands in the world.
     pub fn obstacle(o: &Obstacle) -> Self {
         Self {
@@ -99,7 +99,7 @@ fn sign(x: f32) -> f32 {
     if x < 0.0 { -1.0 } else { 1.0 }
 }
 
-impl Convex for Primitive {
+impl Convex for Solid {
     fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
         let local = self.rotation.tr_mul(d);
         let p = match self.shape {
@@ -143,11 +143,11 @@ mod tests {
     #[test]
     fn primitive_supports_are_extreme_points() {
         let id = [1.0, 0.0, 0.0, 0.0];
-        let b = Primitive::obstacle(&Obstacle::cuboid([1.0, 0.0, 0.0], [0.2, 0.4, 0.6], id).unwrap());
+        let b = Solid::obstacle(&Obstacle::cuboid([1.0, 0.0, 0.0], [0.2, 0.4, 0.6], id).unwrap());
         assert_eq!(b.support(&Vector3::new(1.0, -1.0, 0.5)), Vector3::new(1.1, -0.2, 0.3));
-        let s = Primitive::obstacle(&Obstacle::sphere([0.0, 1.0, 0.0], 0.5).unwrap());
+        let s = Solid::obstacle(&Obstacle::sphere([0.0, 1.0, 0.0], 0.5).unwrap());
         assert!((s.support(&Vector3::new(0.0, 0.0, -3.0)) - Vector3::new(0.0, 1.0, -0.5)).norm() < 1e-7);
-        let c = Primitive::obstacle(&Obstacle::cylinder([0.0; 3], 0.1, 0.4, id).unwrap());
+        let c = Solid::obstacle(&Obstacle::cylinder([0.0; 3], 0.1, 0.4, id).unwrap());
         assert!((c.support(&Vector3::new(3.0, 4.0, 1.0)) - Vector3::new(0.06, 0.08, 0.2)).norm() < 1e-6);
     }
 }

@@ -357,18 +357,18 @@ fn nearest_on_tetrahedron(s: &Simplex) -> (V, Kept) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::collision::convex::Primitive;
+    use crate::collision::convex::Solid;
     use crate::scene::Obstacle;
 
     const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
 
     #[test]
     fn sphere_distances_are_exact() {
-        let a = Primitive::obstacle(&Obstacle::sphere([0.0; 3], 0.5).unwrap());
-        let b = Primitive::obstacle(&Obstacle::sphere([2.0, 0.0, 0.0], 0.25).unwrap());
+        let a = Solid::obstacle(&Obstacle::sphere([0.0; 3], 0.5).unwrap());
+        let b = Solid::obstacle(&Obstacle::sphere([2.0, 0.0, 0.0], 0.25).unwrap());
         assert!((distance_lower_bound(&a, &b) - 1.25).abs() < 1e-5);
         assert!(apart(&a, &b, 1.2, &mut V::zeros()) && !apart(&a, &b, 1.3, &mut V::zeros()));
-        let c = Primitive::obstacle(&Obstacle::sphere([0.6, 0.0, 0.0], 0.25).unwrap());
+        let c = Solid::obstacle(&Obstacle::sphere([0.6, 0.0, 0.0], 0.25).unwrap());
         assert!(!apart(&a, &c, 0.0, &mut V::zeros()));
         // A good hint is kept; a wrong one is replaced by what GJK finds.
         let mut hint = V::new(-1.0, 0.0, 0.0);
@@ -384,18 +384,18 @@ mod tests {
             libm::sinf(core::f32::consts::PI / 8.0),
         );
         // A unit cube turned 45° about z reaches sqrt(0.5) along x.
-        let a = Primitive::obstacle(&Obstacle::cuboid([0.0; 3], [1.0; 3], [w, 0.0, 0.0, z]).unwrap());
-        let b = Primitive::obstacle(&Obstacle::cuboid([1.5, 0.0, 0.0], [1.0; 3], ID).unwrap());
+        let a = Solid::obstacle(&Obstacle::cuboid([0.0; 3], [1.0; 3], [w, 0.0, 0.0, z]).unwrap());
+        let b = Solid::obstacle(&Obstacle::cuboid([1.5, 0.0, 0.0], [1.0; 3], ID).unwrap());
         let d = distance_lower_bound(&a, &b);
         assert!((d - (1.0 - h)).abs() < 1e-4, "{d}");
-        let c = Primitive::obstacle(&Obstacle::cuboid([1.2, 0.0, 0.0], [1.0; 3], ID).unwrap());
+        let c = Solid::obstacle(&Obstacle::cuboid([1.2, 0.0, 0.0], [1.0; 3], ID).unwrap());
         assert!(!apart(&a, &c, 0.0, &mut V::zeros()));
     }
 
     #[test]
     fn cylinder_against_box_edge_on() {
-        let cyl = Primitive::obstacle(&Obstacle::cylinder([0.0; 3], 0.1, 1.0, ID).unwrap());
-        let b = Primitive::obstacle(&Obstacle::cuboid([0.3, 0.0, 0.0], [0.2; 3], ID).unwrap());
+        let cyl = Solid::obstacle(&Obstacle::cylinder([0.0; 3], 0.1, 1.0, ID).unwrap());
+        let b = Solid::obstacle(&Obstacle::cuboid([0.3, 0.0, 0.0], [0.2; 3], ID).unwrap());
         assert!((distance_lower_bound(&cyl, &b) - 0.1).abs() < 1e-4);
     }
 }

@@ -28,7 +28,7 @@
 //! ([`crate::guidance::guides::CLEARANCE_GUIDE`]).
 
 use crate::collision::checker::moves;
-use crate::collision::convex::{Convex, Hull, Primitive};
+use crate::collision::convex::{Convex, Hull, Solid};
 use crate::collision::gjk::{closest, gap_along};
 use crate::error::Error;
 use crate::robot::kinematics::{Cotangent, Joints, Kinematics, forward_with};
@@ -56,10 +56,10 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
             return Err(Error::NonFiniteJoint { joint: joint as u8 });
         }
     }
-    let obstacles: [Primitive; N] = core::array::from_fn(|i| {
+    let obstacles: [Solid; N] = core::array::from_fn(|i| {
         scene.obstacles().get(i).map_or(
-            Primitive::cuboid(&crate::robot::kinematics::Pose::identity(), &Vector3::zeros()),
-            Primitive::obstacle,
+            Solid::cuboid(&crate::robot::kinematics::Pose::identity(), &Vector3::zeros()),
+            Solid::obstacle,
         )
     });
     let obstacles = obstacles.get(..scene.obstacles().len()).unwrap_or(&[]);
@@ -138,17 +138,14 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
                     },
                 );
                 let half = &PANDA.bodies[b].half_extents;
-                let (bb, bc) = (
-                    Primitive::cuboid(&kb.boxes[b], half),
-                    Primitive::cuboid(&kc.boxes[b], half),
-                );
+                let (bb, bc) = (Solid::cuboid(&kb.boxes[b], half), Solid::cuboid(&kc.boxes[b], half));
                 let centers = [&kb.boxes[b].translation, &kc.boxes[b].translation];
                 segment([&hb, &hc], Some([&bb, &bc]), frame, centers, radius[b]);
             }
             if let Some(h) = scene.held() {
                 let (pb, pc) = (
-                    Primitive::attached(h, &kb.frames[HAND_FRAME]),
-                    Primitive::attached(h, &kc.frames[HAND_FRAME]),
+                    Solid::attached(h, &kb.frames[HAND_FRAME]),
+                    Solid::attached(h, &kc.frames[HAND_FRAME]),
                 );
                 segment(
                     [&pb, &pc],
@@ -195,7 +192,7 @@ fn write_gradient<const H: usize>(
 }
 
 /// Whether `a` is proven more than `clearance` from `b` along GJK's vector `v` (from `b` to `a`).
-fn apart_by<A: Convex>(a: &A, b: &Primitive, v: &Vector3<f32>, clearance: f32) -> bool {
+fn apart_by<A: Convex>(a: &A, b: &Solid, v: &Vector3<f32>, clearance: f32) -> bool {
     let len = crate::float::sqrt(v.norm_squared());
     len > 0.0 && len.is_finite() && gap_along(a, b, &(v / len)) >= clearance
 }
@@ -221,7 +218,7 @@ impl Convex for Union<'_> {
 /// The signed separation of `a` from `b` along a direction `n` (unit, from `b` towards `a`) and
 /// that direction: GJK's when they are apart, else the best of `b`'s face normals and the
 /// centres' direction `towards` (see the module docs).
-fn signed_gap<A: Convex>(a: &A, b: &Primitive, towards: &Vector3<f32>) -> (f32, Vector3<f32>) {
+fn signed_gap<A: Convex>(a: &A, b: &Solid, towards: &Vector3<f32>) -> (f32, Vector3<f32>) {
     if let Some(v) = closest(a, b, towards) {
         let len = crate::float::sqrt(v.norm_squared());
         if len > 0.0 && len.is_finite() {
@@ -389,8 +386,8 @@ mod tests {
 
     #[test]
     fn inside_an_obstacle_the_gap_is_negative_and_points_out() {
-        let b = Primitive::obstacle(&Obstacle::cuboid([0.0; 3], [1.0, 1.0, 0.2], [1.0, 0.0, 0.0, 0.0]).unwrap());
-        let a = Primitive::obstacle(&Obstacle::sphere([0.0, 0.3, 0.05], 0.1).unwrap());
+        let b = Solid::obstacle(&Obstacle::cuboid([0.0; 3], [1.0, 1.0, 0.2], [1.0, 0.0, 0.0, 0.0]).unwrap());
+        let a = Solid::obstacle(&Obstacle::sphere([0.0, 0.3, 0.05], 0.1).unwrap());
         let (gap, n) = signed_gap(&a, &b, &Vector3::new(0.0, 0.3, 0.05));
         assert!((gap - (-0.15)).abs() < 1e-5, "{gap}");
         assert!((n - Vector3::z()).norm() < 1e-6, "{n}");

@@ -17,8 +17,7 @@ use edmp_core::prior::Scratch;
 use edmp_core::rng::Rng;
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
-use edmp_core::wire::{Primitive, Problem};
-use serde_json::Value;
+use edmp_core::wire::Problem;
 use std::path::{Path, PathBuf};
 
 /// Rows of the firmware's batch: one per EDMP guide.
@@ -52,66 +51,23 @@ fn scene_name(path: &Path) -> Result<String, String> {
 }
 
 /// The same conversion as `json::parse_problem`: f64 → f32, rounding to nearest.
-fn f32_at(v: &Value, path: &str) -> Result<f32, String> {
-    v.as_f64()
-        .map(|x| x as f32)
-        .ok_or_else(|| format!("{path}: expected a number"))
-}
-
-fn f32s<const K: usize>(v: &Value, path: &str) -> Result<[f32; K], String> {
-    let items = v.as_array().filter(|a| a.len() == K);
-    let items = items.ok_or_else(|| format!("{path}: expected {K} numbers"))?;
-    let mut out = [0.0f32; K];
-    for (slot, item) in out.iter_mut().zip(items) {
-        *slot = f32_at(item, path)?;
-    }
-    Ok(out)
-}
-
-/// A primitive's parameters as the file has them (already validated by `parse_problem`).
-fn primitive(v: &Value, path: &str) -> Result<Primitive, String> {
-    let center = f32s::<3>(&v["center"], &format!("{path}.center"))?;
-    match v["type"].as_str() {
-        Some("cuboid") => Ok(Primitive::Cuboid {
-            center,
-            dims: f32s::<3>(&v["dims"], &format!("{path}.dims"))?,
-            quaternion: f32s::<4>(&v["quaternion"], &format!("{path}.quaternion"))?,
-        }),
-        Some("cylinder") => Ok(Primitive::Cylinder {
-            center,
-            radius: f32_at(&v["radius"], &format!("{path}.radius"))?,
-            height: f32_at(&v["height"], &format!("{path}.height"))?,
-            quaternion: f32s::<4>(&v["quaternion"], &format!("{path}.quaternion"))?,
-        }),
-        Some("sphere") => Ok(Primitive::Sphere {
-            center,
-            radius: f32_at(&v["radius"], &format!("{path}.radius"))?,
-        }),
-        _ => Err(format!("{path}.type: expected cuboid, cylinder or sphere")),
-    }
-}
-
 /// The wire problem of a scene file: validated by `parse_problem`, goal resolved to joints.
 pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, String> {
     let parsed = parse_problem(text).map_err(|e| e.to_string())?;
     let goal = joint_goal(&parsed)?;
-    let root: Value = serde_json::from_str(text).map_err(|e| e.to_string())?;
     let mut problem = Problem {
         obstacles: Default::default(),
-        held: None,
+        held: parsed.held,
         finger: parsed.scene.gripper(),
         start: parsed.start,
         goal,
         seed,
     };
-    for (i, o) in root["obstacles"].as_array().into_iter().flatten().enumerate() {
+    for p in &parsed.primitives {
         problem
             .obstacles
-            .push(primitive(o, &format!("obstacles[{i}]"))?)
+            .push(*p)
             .map_err(|_| format!("more than {MAX_OBSTACLES} obstacles"))?;
-    }
-    if let Some(h) = root.get("held_object") {
-        problem.held = Some(primitive(h, "held_object")?);
     }
     // The firmware rebuilds the scene from these numbers: it must be the host's scene exactly.
     let rebuilt = problem.to_scene().map_err(|e| e.to_string())?;

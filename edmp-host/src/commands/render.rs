@@ -6,8 +6,8 @@
 //! colour per collision-free candidate, grey for colliding ones.
 //! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
 
-use crate::formats::json::{Goal, parse_problem};
-use edmp_core::collision::convex::{Convex, Primitive};
+use crate::formats::json::{Goal, parse_plan, parse_problem};
+use edmp_core::collision::convex::{Convex, Solid};
 use edmp_core::robot::kinematics::{Joints, forward, forward_with};
 use edmp_core::robot::{BODIES, PANDA};
 use edmp_core::scene::Shape;
@@ -174,7 +174,7 @@ fn hull2(mut pts: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
 
 /// Outline points of a primitive (from its support function in 64 directions around each
 /// view axis, enough for the silhouettes of boxes, cylinders and spheres).
-fn outline(p: &Primitive) -> Vec<Vector3<f32>> {
+fn outline(p: &Solid) -> Vec<Vector3<f32>> {
     let mut out = Vec::new();
     for k in 0..64 {
         let a = k as f32 * core::f32::consts::TAU / 64.0;
@@ -234,29 +234,6 @@ fn draw_tcp_path(
     Ok(())
 }
 
-/// Waypoints of a plan-like JSON value (`{"waypoints": [[7 numbers], ...]}`), named by `at`.
-fn waypoints(value: &serde_json::Value, at: &str) -> Result<Vec<Joints<f32>>, String> {
-    let rows = value["waypoints"]
-        .as_array()
-        .ok_or(format!("{at}.waypoints: expected an array"))?;
-    rows.iter()
-        .enumerate()
-        .map(|(i, w)| {
-            let q: Vec<f32> = w
-                .as_array()
-                .map(|a| {
-                    a.iter()
-                        .filter_map(serde_json::Value::as_f64)
-                        .map(|x| x as f32)
-                        .collect()
-                })
-                .unwrap_or_default();
-            q.try_into()
-                .map_err(|_| format!("{at}.waypoints[{i}]: expected 7 numbers"))
-        })
-        .collect()
-}
-
 fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, finger: f32, color: [f32; 3], alpha: f32) -> Result<(), String> {
     let k = forward_with(q, finger).map_err(|e| e.to_string())?;
     for b in 0..BODIES {
@@ -271,11 +248,11 @@ fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, finger: f32, color: [f32; 3]
 pub fn run(args: &Args) -> Result<(), String> {
     let text = std::fs::read_to_string(&args.scene).map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let problem = parse_problem(&text).map_err(|e| format!("{}: {e}", args.scene.display()))?;
-    let plan: Option<serde_json::Value> = match &args.plan {
-        Some(path) => Some(
-            serde_json::from_str(&std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?)
-                .map_err(|e| format!("{}: {e}", path.display()))?,
-        ),
+    let plan = match &args.plan {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            Some(parse_plan(&text).map_err(|e| format!("{}: {e}", path.display()))?)
+        }
         None => None,
     };
     let mut canvas = Canvas::new(VIEWS.len() * PANEL, PANEL);
@@ -305,13 +282,10 @@ pub fn run(args: &Args) -> Result<(), String> {
         );
     }
     for o in problem.scene.obstacles() {
-        draw(&mut canvas, &outline(&Primitive::obstacle(o)), [0.35, 0.35, 0.38], 0.45);
+        draw(&mut canvas, &outline(&Solid::obstacle(o)), [0.35, 0.35, 0.38], 0.45);
     }
     let finger = problem.scene.gripper();
-    let path = match (&plan, &args.plan) {
-        (Some(plan), Some(file)) => Some(waypoints(plan, &file.display().to_string())?),
-        _ => None,
-    };
+    let path = plan.as_ref().map(|p| &p.waypoints);
     if let Some(path) = &path {
         let n = path.len().max(1);
         for (i, q) in path.iter().enumerate().step_by(4) {
@@ -331,23 +305,18 @@ pub fn run(args: &Args) -> Result<(), String> {
     if args.candidates {
         let list = plan
             .as_ref()
-            .and_then(|p| p["candidates"].as_array())
+            .map(|p| &p.candidates)
+            .filter(|c| !c.is_empty())
             .ok_or("--candidates: the plan has no candidates (write it with `edmp-host plan --candidates`)")?;
         let mut free = 0;
-        for (i, c) in list.iter().enumerate() {
-            let colour = if c["collision_free"].as_bool() == Some(true) {
+        for c in list {
+            let colour = if c.collision_free {
                 free += 1;
                 CANDIDATE_COLOURS[(free - 1) % CANDIDATE_COLOURS.len()]
             } else {
                 [0.55; 3]
             };
-            draw_tcp_path(
-                &mut canvas,
-                &waypoints(c, &format!("candidates[{i}]"))?,
-                2.0,
-                colour,
-                0.8,
-            )?;
+            draw_tcp_path(&mut canvas, &c.waypoints, 2.0, colour, 0.8)?;
         }
     }
     if let Some(path) = &path {

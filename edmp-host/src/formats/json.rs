@@ -1,12 +1,13 @@
-//! The `edmp-scene/1` format (`shared/spec/formats.md`): parsing with errors that name the
-//! offending field by its JSON path, e.g. `obstacles[3].quaternion: norm 0.71, expected 1`.
+//! The `edmp-scene/1` scene and `edmp-plan/1` plan formats (docs/formats.md): reading with
+//! errors that name the offending field by its JSON path, e.g. `obstacles[3].quaternion: norm
+//! 0.71, expected 1`, and writing a primitive back.
 
 use edmp_core::collision::checker::{CheckConfig, Contact, check_end};
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
 use edmp_core::robot::{BODY_NAMES, FINGER_OPENING_MAX, FINGER_OPENING_MIN, JOINT_NAMES, JOINTS, PANDA};
-use edmp_core::scene::{MAX_OBSTACLES, Obstacle, QUATERNION_NORM_TOLERANCE, Scene, SceneError, rotation_from_wxyz};
-use serde_json::{Map, Value};
+use edmp_core::scene::{MAX_OBSTACLES, Primitive, QUATERNION_NORM_TOLERANCE, Scene, SceneError, rotation_from_wxyz};
+use serde_json::{Map, Value, json};
 use std::fmt;
 
 /// A field of the input that is wrong, and why.
@@ -54,6 +55,11 @@ pub enum Goal {
 pub struct Problem {
     /// The obstacles, the held object and the finger opening (`gripper.finger`).
     pub scene: Scene<MAX_OBSTACLES>,
+    /// The obstacles' parameters as the file gives them, in the scene's order (what the wire to
+    /// firmware carries).
+    pub primitives: Vec<Primitive>,
+    /// The held object's parameters, if any.
+    pub held: Option<Primitive>,
     /// The start configuration.
     pub start: Joints<f32>,
     /// The goal: joints or a TCP pose.
@@ -128,19 +134,25 @@ fn quaternion(v: &Value, path: &str) -> Result<[f32; 4], InputError> {
     Ok(q)
 }
 
-fn primitive(v: &Value, path: &str) -> Result<Obstacle, InputError> {
+/// An `edmp-scene/1` primitive (an obstacle or the held object) at `path`: its parameters as
+/// the file gives them, validated as an obstacle ([`Primitive::to_obstacle`]).
+pub fn primitive(v: &Value, path: &str) -> Result<Primitive, InputError> {
     let kind = v
         .get("type")
         .and_then(Value::as_str)
         .ok_or_else(|| InputError::at(&format!("{path}.type"), "missing (cuboid, cylinder or sphere)"))?;
-    match kind {
+    let (primitive, size_field) = match kind {
         "cuboid" => {
             let map = object(v, path, &["type", "center", "dims", "quaternion"])?;
             let (c, cp) = field(map, path, "center")?;
             let (d, dp) = field(map, path, "dims")?;
             let (q, qp) = field(map, path, "quaternion")?;
-            let (center, dims, quat) = (numbers::<3>(c, &cp)?, numbers::<3>(d, &dp)?, quaternion(q, &qp)?);
-            Obstacle::cuboid(center, dims, quat).map_err(|e| scene_error(e, path, "dims"))
+            let primitive = Primitive::Cuboid {
+                center: numbers::<3>(c, &cp)?,
+                dims: numbers::<3>(d, &dp)?,
+                quaternion: quaternion(q, &qp)?,
+            };
+            (primitive, "dims")
         }
         "cylinder" => {
             let map = object(v, path, &["type", "center", "radius", "height", "quaternion"])?;
@@ -148,25 +160,59 @@ fn primitive(v: &Value, path: &str) -> Result<Obstacle, InputError> {
             let (r, rp) = field(map, path, "radius")?;
             let (h, hp) = field(map, path, "height")?;
             let (q, qp) = field(map, path, "quaternion")?;
-            let (center, radius, height, quat) = (
+            let (center, radius, height, quaternion) = (
                 numbers::<3>(c, &cp)?,
                 number(r, &rp)?,
                 number(h, &hp)?,
                 quaternion(q, &qp)?,
             );
             let size = if radius > 0.0 { "height" } else { "radius" };
-            Obstacle::cylinder(center, radius, height, quat).map_err(|e| scene_error(e, path, size))
+            let primitive = Primitive::Cylinder {
+                center,
+                radius,
+                height,
+                quaternion,
+            };
+            (primitive, size)
         }
         "sphere" => {
             let map = object(v, path, &["type", "center", "radius"])?;
             let (c, cp) = field(map, path, "center")?;
             let (r, rp) = field(map, path, "radius")?;
-            Obstacle::sphere(numbers::<3>(c, &cp)?, number(r, &rp)?).map_err(|e| scene_error(e, path, "radius"))
+            let primitive = Primitive::Sphere {
+                center: numbers::<3>(c, &cp)?,
+                radius: number(r, &rp)?,
+            };
+            (primitive, "radius")
         }
-        other => Err(InputError::at(
-            &format!("{path}.type"),
-            format!("unknown type {other:?} (cuboid, cylinder or sphere)"),
-        )),
+        other => {
+            return Err(InputError::at(
+                &format!("{path}.type"),
+                format!("unknown type {other:?} (cuboid, cylinder or sphere)"),
+            ));
+        }
+    };
+    primitive.to_obstacle().map_err(|e| scene_error(e, path, size_field))?;
+    Ok(primitive)
+}
+
+/// A primitive as `edmp-scene/1` writes it (the inverse of [`primitive`]).
+pub fn primitive_json(primitive: &Primitive) -> Value {
+    match *primitive {
+        Primitive::Cuboid {
+            center,
+            dims,
+            quaternion,
+        } => json!({"type": "cuboid", "center": center, "dims": dims, "quaternion": quaternion}),
+        Primitive::Cylinder {
+            center,
+            radius,
+            height,
+            quaternion,
+        } => {
+            json!({"type": "cylinder", "center": center, "radius": radius, "height": height, "quaternion": quaternion})
+        }
+        Primitive::Sphere { center, radius } => json!({"type": "sphere", "center": center, "radius": radius}),
     }
 }
 
@@ -249,12 +295,22 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
         ));
     }
     let mut scene = Scene::<MAX_OBSTACLES>::new();
+    let mut primitives = Vec::with_capacity(list.len());
     for (i, o) in list.iter().enumerate() {
-        let built = primitive(o, &format!("obstacles[{i}]"))?;
+        let p = primitive(o, &format!("obstacles[{i}]"))?;
+        let built = p.to_obstacle().map_err(|e| InputError::at(&op, e.to_string()))?;
         scene.push(built).map_err(|e| InputError::at(&op, e.to_string()))?;
+        primitives.push(p);
     }
-    if let Some(held) = map.get("held_object") {
-        scene.hold(primitive(held, "held_object")?);
+    let held = map
+        .get("held_object")
+        .map(|h| primitive(h, "held_object"))
+        .transpose()?;
+    if let Some(h) = &held {
+        scene.hold(
+            h.to_obstacle()
+                .map_err(|e| InputError::at("held_object", e.to_string()))?,
+        );
     }
     // Before the ends are checked: the fingers sit at this opening for the whole problem.
     if let Some(gripper) = map.get("gripper") {
@@ -301,7 +357,13 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
         }
         _ => return Err(InputError::at(&gp, "expected exactly one of \"joints\" or \"pose\"")),
     };
-    Ok(Problem { scene, start, goal })
+    Ok(Problem {
+        scene,
+        primitives,
+        held,
+        start,
+        goal,
+    })
 }
 
 /// One alternative path of a plan written with `--candidates`.

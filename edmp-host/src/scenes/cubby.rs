@@ -3,7 +3,7 @@
 //! Merged: two pockets are drawn and the shelf and/or wall between them is removed (MpiNets
 //! keeps it at zero thickness; zero sizes are invalid in our scene format, so it is left out).
 
-use super::{Approach, Environment, Prim, Region, yaw_quaternion};
+use super::{Approach, Environment, Primitive, Region, yaw_quaternion};
 use edmp_core::rng::Rng;
 
 pub(super) fn generate(rng: &mut Rng, merged: bool) -> Environment {
@@ -55,7 +55,7 @@ pub(super) fn generate(rng: &mut Rng, merged: bool) -> Environment {
         .into_iter()
         .map(|(p, dims)| {
             let [x, y] = turn(p[0], p[1]);
-            Prim::Cuboid {
+            Primitive::Cuboid {
                 center: [x, y, p[2]],
                 dims,
                 quaternion: yaw_quaternion(yaw),

@@ -4,7 +4,7 @@
 //! Simplifications: closed drawers are their front panels only (the rest is hidden in the
 //! body); MpiNets' 70 % rejection of start and goal drawers at the same height is not applied.
 
-use super::{Approach, Environment, Prim, Region, yaw_quaternion};
+use super::{Approach, Environment, Primitive, Region, yaw_quaternion};
 use edmp_core::rng::Rng;
 
 struct Cell {
@@ -172,7 +172,7 @@ pub(super) fn generate(rng: &mut Rng) -> Environment {
     let place = |p: [f32; 3]| [origin[0] + c * p[0] - s * p[1], origin[1] + s * p[0] + c * p[1], p[2]];
     let prims = local
         .into_iter()
-        .map(|(p, dims)| Prim::Cuboid {
+        .map(|(p, dims)| Primitive::Cuboid {
             center: place(p),
             dims,
             quaternion: yaw_quaternion(yaw),

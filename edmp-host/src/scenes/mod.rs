@@ -17,12 +17,13 @@ mod tabletop;
 mod under_table;
 mod window_box;
 
+use crate::formats::json::primitive_json;
 use edmp_core::collision::checker::{CheckConfig, check_state};
 use edmp_core::rng::Rng;
 use edmp_core::robot::PANDA;
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
-use edmp_core::scene::{MAX_OBSTACLES, Obstacle, Scene};
+use edmp_core::scene::{MAX_OBSTACLES, Primitive, Scene};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use serde_json::{Value, json};
 
@@ -69,60 +70,6 @@ impl Family {
     }
 }
 
-/// A primitive as the scene format writes it (quaternion `[w, x, y, z]`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Prim {
-    Cuboid {
-        center: [f32; 3],
-        dims: [f32; 3],
-        quaternion: [f32; 4],
-    },
-    Cylinder {
-        center: [f32; 3],
-        radius: f32,
-        height: f32,
-        quaternion: [f32; 4],
-    },
-}
-
-impl Prim {
-    fn obstacle(&self) -> Option<Obstacle> {
-        match *self {
-            Prim::Cuboid {
-                center,
-                dims,
-                quaternion,
-            } => Obstacle::cuboid(center, dims, quaternion).ok(),
-            Prim::Cylinder {
-                center,
-                radius,
-                height,
-                quaternion,
-            } => Obstacle::cylinder(center, radius, height, quaternion).ok(),
-        }
-    }
-
-    fn json(&self) -> Value {
-        match self {
-            Prim::Cuboid {
-                center,
-                dims,
-                quaternion,
-            } => {
-                json!({"type": "cuboid", "center": center, "dims": dims, "quaternion": quaternion})
-            }
-            Prim::Cylinder {
-                center,
-                radius,
-                height,
-                quaternion,
-            } => {
-                json!({"type": "cylinder", "center": center, "radius": radius, "height": height, "quaternion": quaternion})
-            }
-        }
-    }
-}
-
 /// The quaternion `[w, x, y, z]` of a turn by `yaw` about world z.
 pub(crate) fn yaw_quaternion(yaw: f32) -> [f32; 4] {
     [(yaw * 0.5).cos(), 0.0, 0.0, (yaw * 0.5).sin()]
@@ -160,8 +107,8 @@ impl Frame {
     }
 
     /// The cuboid spanning local `lo` to `hi`, turned with the frame.
-    pub(crate) fn cuboid(&self, lo: [f32; 3], hi: [f32; 3]) -> Prim {
-        Prim::Cuboid {
+    pub(crate) fn cuboid(&self, lo: [f32; 3], hi: [f32; 3]) -> Primitive {
+        Primitive::Cuboid {
             center: self.point(core::array::from_fn(|i| (lo[i] + hi[i]) / 2.0)),
             dims: core::array::from_fn(|i| hi[i] - lo[i]),
             quaternion: yaw_quaternion(self.yaw),
@@ -169,8 +116,8 @@ impl Frame {
     }
 
     /// An upright cylinder standing at local `(x, y, z)`.
-    pub(crate) fn cylinder(&self, foot: [f32; 3], radius: f32, height: f32) -> Prim {
-        Prim::Cylinder {
+    pub(crate) fn cylinder(&self, foot: [f32; 3], radius: f32, height: f32) -> Primitive {
+        Primitive::Cylinder {
             center: self.point([foot[0], foot[1], foot[2] + height / 2.0]),
             radius,
             height,
@@ -205,7 +152,7 @@ pub(crate) fn clutter(
     z: f32,
     max_height: f32,
     count: usize,
-    out: &mut Vec<Prim>,
+    out: &mut Vec<Primitive>,
 ) {
     let [x, y] = area;
     if max_height < 0.06 {
@@ -246,7 +193,7 @@ pub(crate) fn clutter(
         if can {
             out.push(frame.cylinder([c[0], c[1], z], radius, height));
         } else {
-            out.push(Prim::Cuboid {
+            out.push(Primitive::Cuboid {
                 center: frame.point([c[0], c[1], z + height / 2.0]),
                 dims: [dims[0], dims[1], height],
                 quaternion: yaw_quaternion(frame.yaw + yaw),
@@ -327,7 +274,7 @@ impl Region {
 /// One generated environment: its obstacles, and the regions for start and goal.
 #[derive(Clone, Debug)]
 pub(crate) struct Environment {
-    pub prims: Vec<Prim>,
+    pub prims: Vec<Primitive>,
     /// Candidate regions; a task-oriented problem takes its ends from two of them.
     pub regions: Vec<Region>,
     /// Goal regions (the unseen kinds): when not empty, posed goals come from here and
@@ -340,7 +287,7 @@ impl Environment {
     pub(crate) fn scene(&self) -> Option<Scene<MAX_OBSTACLES>> {
         let mut scene = Scene::new();
         for p in &self.prims {
-            scene.push(p.obstacle()?).ok()?;
+            scene.push(p.to_obstacle().ok()?).ok()?;
         }
         Some(scene)
     }
@@ -530,7 +477,7 @@ impl Problem {
         let q = self.goal_pose.quaternion_wxyz();
         json!({
             "format": "edmp-scene/1",
-            "obstacles": self.env.prims.iter().map(Prim::json).collect::<Vec<_>>(),
+            "obstacles": self.env.prims.iter().map(primitive_json).collect::<Vec<_>>(),
             "start": self.start,
             "goal": {"joints": self.goal},
             "meta": {
@@ -552,13 +499,13 @@ mod tests {
     use nalgebra::{Quaternion, UnitQuaternion};
 
     /// Whether world point `p` is inside primitive `prim` (for the geometry tests).
-    fn inside(prim: &Prim, p: Vector3<f32>) -> bool {
+    fn inside(prim: &Primitive, p: Vector3<f32>) -> bool {
         let local = |center: [f32; 3], q: [f32; 4]| {
             let turn = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
             turn.inverse() * (p - Vector3::from(center))
         };
         match *prim {
-            Prim::Cuboid {
+            Primitive::Cuboid {
                 center,
                 dims,
                 quaternion,
@@ -566,7 +513,7 @@ mod tests {
                 let l = local(center, quaternion);
                 (0..3).all(|i| l[i].abs() <= dims[i] / 2.0)
             }
-            Prim::Cylinder {
+            Primitive::Cylinder {
                 center,
                 radius,
                 height,
@@ -575,6 +522,7 @@ mod tests {
                 let l = local(center, quaternion);
                 l.x * l.x + l.y * l.y <= radius * radius && l.z.abs() <= height / 2.0
             }
+            Primitive::Sphere { center, radius } => (p - Vector3::from(center)).norm() <= radius,
         }
     }
 
@@ -612,8 +560,9 @@ mod tests {
                 assert!(!env.goals.is_empty() && !env.regions.is_empty(), "{family:?} {seed}");
                 for p in &env.prims {
                     let thin = match *p {
-                        Prim::Cuboid { dims, .. } => dims.iter().copied().fold(f32::INFINITY, f32::min),
-                        Prim::Cylinder { radius, height, .. } => (2.0 * radius).min(height),
+                        Primitive::Cuboid { dims, .. } => dims.iter().copied().fold(f32::INFINITY, f32::min),
+                        Primitive::Cylinder { radius, height, .. } => (2.0 * radius).min(height),
+                        Primitive::Sphere { radius, .. } => 2.0 * radius,
                     };
                     assert!(thin >= 0.01, "{family:?} seed {seed}: {p:?}");
                 }
@@ -688,16 +637,19 @@ mod tests {
     fn cage_slots_are_between_bars() {
         for seed in 0..100u64 {
             let env = environment(Family::Cage, &mut Rng::new(seed));
-            let bars: Vec<&Prim> = env.prims[6..]
+            let bars: Vec<&Primitive> = env.prims[6..]
                 .iter()
                 .filter(|p| match p {
-                    Prim::Cylinder { radius, height, .. } => *radius <= 0.015 && *height >= 0.38,
-                    Prim::Cuboid { dims, .. } => dims[0] <= 0.03 && dims[1] <= 0.03 && dims[2] >= 0.38,
+                    Primitive::Cylinder { radius, height, .. } => *radius <= 0.015 && *height >= 0.38,
+                    Primitive::Cuboid { dims, .. } => dims[0] <= 0.03 && dims[1] <= 0.03 && dims[2] >= 0.38,
+                    Primitive::Sphere { .. } => false,
                 })
                 .collect();
             assert_eq!(bars.len(), env.goals.len() + 1, "seed {seed}");
-            let centre = |p: &Prim| match *p {
-                Prim::Cuboid { center, .. } | Prim::Cylinder { center, .. } => Vector3::from(center),
+            let centre = |p: &Primitive| match *p {
+                Primitive::Cuboid { center, .. }
+                | Primitive::Cylinder { center, .. }
+                | Primitive::Sphere { center, .. } => Vector3::from(center),
             };
             for pair in bars.windows(2) {
                 let gap = (centre(pair[1]) - centre(pair[0])).norm();

@@ -3,7 +3,7 @@
 //! Simplifications: an object's clearance to the others is measured between bounding circles
 //! of their footprints (MpiNets uses the exact SDF); pose regions are clipped to the arm's reach.
 
-use super::{Approach, Environment, Prim, Region, yaw_quaternion};
+use super::{Approach, Environment, Primitive, Region, yaw_quaternion};
 use edmp_core::rng::Rng;
 
 /// Beyond this distance from the base the Panda's TCP cannot go; regions are clipped to it.
@@ -34,7 +34,7 @@ pub(super) fn generate(rng: &mut Rng) -> Environment {
     } else {
         rng.uniform_f32(-0.75, -0.55)
     };
-    let table = |x: [f32; 2], y: [f32; 2]| Prim::Cuboid {
+    let table = |x: [f32; 2], y: [f32; 2]| Primitive::Cuboid {
         center: [(x[0] + x[1]) / 2.0, (y[0] + y[1]) / 2.0, (h - 0.02) / 2.0],
         dims: [x[1] - x[0], y[1] - y[0], h + 0.02],
         quaternion: [1.0, 0.0, 0.0, 0.0],
@@ -60,7 +60,7 @@ pub(super) fn generate(rng: &mut Rng) -> Environment {
             mount_y = 2.0 * (cy - ys1);
         }
     }
-    prims.push(Prim::Cuboid {
+    prims.push(Primitive::Cuboid {
         center: [cx, cy, -0.01],
         dims: [2.0 * (x0 - cx), mount_y, 0.02],
         quaternion: [1.0, 0.0, 0.0, 0.0],
@@ -96,7 +96,7 @@ pub(super) fn generate(rng: &mut Rng) -> Environment {
         let center = [c[0], c[1], h + height / 2.0];
         if rng.unit_f32() < 0.3 {
             let radius = rng.uniform_f32(0.05, limit);
-            prims.push(Prim::Cylinder {
+            prims.push(Primitive::Cylinder {
                 center,
                 radius,
                 height,
@@ -106,7 +106,7 @@ pub(super) fn generate(rng: &mut Rng) -> Environment {
         } else {
             let (dx, dy) = (rng.uniform_f32(0.05, limit), rng.uniform_f32(0.05, limit));
             let yaw = rng.uniform_f32(0.0, core::f32::consts::FRAC_PI_2);
-            prims.push(Prim::Cuboid {
+            prims.push(Primitive::Cuboid {
                 center,
                 dims: [dx, dy, height],
                 quaternion: yaw_quaternion(yaw),
