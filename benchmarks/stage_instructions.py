@@ -28,9 +28,9 @@ STAGES = {
     "network": ("edmp_core::prior::net::predict_noise_on", "edmp_core::prior::net::predict_noise"),
     "guidance": "edmp_core::guidance::step_rows",
     "costs": ("edmp_core::cost::trajectory_cost_memo", "edmp_core::cost::trajectory_cost"),
-    "select": "edmp_core::planner::judge",
-    "global": ("edmp_core::global::rescue", "edmp_core::planner::finish"),
-    "shortcut": ("edmp_core::shortcut::shorten", "edmp_core::planner::polish"),
+    "select": "edmp_core::planner::judge::judge",
+    "global": ("edmp_core::planner::global::rescue", "edmp_core::planner::finish_on"),
+    "shortcut": ("edmp_core::planner::shortcut::shorten", "edmp_core::planner::polish"),
 }
 
 

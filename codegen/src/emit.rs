@@ -23,7 +23,7 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         w,
         &format!(
             "// Finger frames are their fixed transform at opening 0 plus `slide` times the opening w, an input \
-             (the scene's `gripper.finger`, default {FINGER_OPENING} m, shared/spec/formats.md)."
+             (the scene's `gripper.finger`, default {FINGER_OPENING} m, docs/formats.md)."
         ),
     );
     wl(w, "");
@@ -51,7 +51,7 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     wl(w, &format!("pub const HAND_FRAME: usize = {};", chain.hand));
     wl(
         w,
-        "/// Default opening of each finger, metres: what an absent `gripper` field means (shared/spec/formats.md).",
+        "/// Default opening of each finger, metres: what an absent `gripper` field means (docs/formats.md).",
     );
     wl(
         w,

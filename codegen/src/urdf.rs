@@ -6,12 +6,12 @@ use crate::mesh::{self, OrientedBox};
 use std::path::{Path, PathBuf};
 
 /// Default opening of each Panda finger: the MpiNets / robofin convention that
-/// `shared/spec/formats.md` makes the value of an absent `gripper` field. The opening itself is
+/// docs/formats.md makes the value of an absent `gripper` field. The opening itself is
 /// an input (the scene's `gripper.finger`), not folded into the tables.
 pub const FINGER_OPENING: f64 = 0.025;
-/// The URDF link that is the tool centre point (`spec/formats.md`).
+/// The URDF link that is the tool centre point (docs/formats.md).
 pub const TCP_LINK: &str = "panda_grasptarget";
-/// The URDF link that a held object is attached to (`spec/formats.md`).
+/// The URDF link that a held object is attached to (docs/formats.md).
 pub const HAND_LINK: &str = "panda_hand";
 
 /// How a frame moves relative to its parent.

@@ -6,12 +6,13 @@
 pub mod commands;
 pub mod formats;
 mod metrics;
+pub mod planning;
 mod plots;
 mod rrt;
 mod scenes;
 pub mod threads;
 
-/// What went wrong, and the exit status it maps to (`spec/formats.md`).
+/// What went wrong, and the exit status it maps to (docs/formats.md).
 #[derive(Debug)]
 pub enum Failure {
     /// Bad input or I/O: exit 2, nothing written.

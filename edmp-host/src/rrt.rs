@@ -126,7 +126,7 @@ struct Planner<'a, const N: usize> {
 }
 
 impl<const N: usize> Planner<'_, N> {
-    /// A valid end (`spec/formats.md`): inside the limits and free by PyBullet's own rule.
+    /// A valid end (docs/formats.md): inside the limits and free by PyBullet's own rule.
     fn valid_end(&self, q: &Joints<f32>) -> Result<bool, RrtError> {
         let ok = PANDA.within_soft_limits(q, 0.0);
         Ok(ok

@@ -6,9 +6,9 @@ use core::fmt::Write as _;
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::planner::PlanConfig;
 use edmp_core::robot::kinematics::forward;
-use edmp_host::commands::plan::{chosen_guides, plan_problem};
 use edmp_host::formats::json::{Goal, joint_goal, parse_problem};
 use edmp_host::formats::moveit::{Source, import, import_validated};
+use edmp_host::planning::{chosen_guides, plan_problem};
 use serde_json::{Value, json};
 use std::process::Command;
 

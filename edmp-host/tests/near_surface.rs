@@ -1,6 +1,6 @@
 //! The near-surface table (`benchmarks/near_surface/`, recorded by `benchmarks/near_surface.py`
 //! with PyBullet): starts and goals 0.05-2 mm from a table, a shelf board and a drawer front
-//! by PyBullet's own measure are valid ends (`spec/formats.md`) and must plan.
+//! by PyBullet's own measure are valid ends (docs/formats.md) and must plan.
 
 use std::process::Command;
 

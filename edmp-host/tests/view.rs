@@ -6,7 +6,8 @@
 
 use edmp_core::robot::kinematics::forward_with;
 use edmp_host::commands::view::EVEN_STEP_S;
-use edmp_host::formats::json::{parse_plan, parse_problem};
+use edmp_host::formats::json::parse_problem;
+use edmp_host::formats::plan::parse_plan;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

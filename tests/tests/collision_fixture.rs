@@ -121,7 +121,7 @@ fn self_contacts_are_never_missed() {
     );
 }
 
-/// The valid-end rule (`spec/formats.md`): a start or goal PyBullet finds free must be accepted,
+/// The valid-end rule (docs/formats.md): a start or goal PyBullet finds free must be accepted,
 /// one it finds touching never. Measures how far PyBullet inflates our hulls (certified distance
 /// minus PyBullet's, near contact) and what `check_end` does on every pair within 2 mm.
 #[test]

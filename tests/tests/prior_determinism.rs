@@ -1,7 +1,6 @@
 //! Bit-identical sampling: a fixed unguided run hashes to the same value on every target and
-//! build (x86_64 baseline, x86-64-v3, thumbv7em; issue 8 checks the last under QEMU). The
-//! golden value changes only when the committed weights or the network's arithmetic do (last:
-//! 2026-12-02, Mish's `e^x` as `expf(x/8)⁸`).
+//! build (x86_64 baseline, x86-64-v3, thumbv7em; scripts/firmware checks the last under QEMU). The
+//! golden value changes only when the committed weights or the network's arithmetic do.
 
 use edmp_core::path::{HORIZON, Path};
 use edmp_core::prior::{Sampler, Scratch, sample};

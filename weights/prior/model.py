@@ -1,6 +1,6 @@
 """The temporal 1-D UNet of EDMP, scaled down, and its diffusion schedule.
 
-The layout follows the original (shared/notes/edmp-reference.md §2): Conv1d(k=5) -> GroupNorm(8)
+The layout follows the original implementation (vishal-2000/EDMP): Conv1d(k=5) -> GroupNorm(8)
 -> Mish blocks, residual blocks with a sinusoidal time embedding, stride-2 downsampling, transposed-
 conv upsampling with a crop back to the skip's length (50 -> 25 -> 13 and back), no attention.
 Differences: the channel widths, and (`top_skip`, default on) the first level's full-resolution

@@ -4,7 +4,7 @@
 
 writes `prior.safetensors` (float32, EMA weights), `prior.json` (everything inference needs),
 `loss.png` (training and held-out loss) and `train_log.json` (the run: command, seeds, timing).
-Recipe (shared/notes/edmp-reference.md §6, deviations marked): epsilon prediction, MSE, t uniform
+Recipe (the original implementation, vishal-2000/EDMP; deviations marked): epsilon prediction, MSE, t uniform
 in 1..255, start and goal written into x_t; Adam. Deviations: lr 1e-3 with cosine decay and a
 batch of 256 instead of lr 1e-4 at 2048 (a CPU budget, not a GPU one), an EMA of the weights
 (0.999), and the loss over the 48 interior waypoints only (the two inpainted columns carry noise the

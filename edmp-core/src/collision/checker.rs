@@ -7,7 +7,7 @@
 //! contact. Cheap tests run first and can only prove freedom: bounding balls, then the body's
 //! oriented box (which holds its hull).
 //!
-//! Checked, as `spec/formats.md` defines a solved problem: every moving body (links 1-7, hand,
+//! Checked, as docs/formats.md defines a solved problem: every moving body (links 1-7, hand,
 //! fingers, held object) against every obstacle, and every pair of bodies that are not chain
 //! neighbours (link7, hand, fingers and held object form one rigid group), at every waypoint
 //! and at every state of the linear joint interpolation in steps of at most `max_step`.
@@ -30,7 +30,7 @@ pub const DEFAULT_MARGIN: f32 = 0.002;
 /// so PyBullet calls a hull in contact exactly when its true distance is ≤ about 1 mm.
 pub const PYBULLET_HULL_MARGIN: f32 = 0.001;
 /// Clearance demanded between a robot body and an obstacle near the ends: PyBullet's own
-/// contact rule (`spec/formats.md`, valid ends) plus 10 µm for the hulls' and the kinematics'
+/// contact rule (docs/formats.md, valid ends) plus 10 µm for the hulls' and the kinematics'
 /// differences. A grasp pose 0.05 mm above a table (by PyBullet) passes; one PyBullet finds
 /// touching never does.
 pub const END_MARGIN: f32 = PYBULLET_HULL_MARGIN + 0.000_01;
@@ -41,7 +41,7 @@ pub const SELF_MARGIN: f32 = 2.0 * END_MARGIN;
 /// [`END_MARGIN`] replaces [`DEFAULT_MARGIN`]: a path may leave a surface the user's end
 /// touches, and must be 2 mm clear once it is this far from the end.
 pub const END_RADIUS: f32 = 0.05;
-/// Largest joint step between checked states (`spec/formats.md`).
+/// Largest joint step between checked states (docs/formats.md).
 pub const MAX_JOINT_STEP: f32 = 0.01;
 /// Fixed budget of interpolated states per segment: the widest joint range (6.6 rad) at
 /// 0.01 rad needs 664, so only waypoints outside the limits can exceed it.
@@ -68,7 +68,7 @@ pub struct CheckConfig {
 }
 
 impl CheckConfig {
-    /// The project's definition of a solved problem (`shared/spec/formats.md`).
+    /// The project's definition of a solved problem (docs/formats.md).
     pub const DEFAULT: Self = Self {
         margin: DEFAULT_MARGIN,
         end_margin: END_MARGIN,
@@ -495,7 +495,7 @@ pub fn check_state<const N: usize>(
 }
 
 /// Checks a start or goal as the user gave it: obstacles at `end_margin`, PyBullet's own
-/// contact rule (`spec/formats.md`, valid ends), not the planner's margin.
+/// contact rule (docs/formats.md, valid ends), not the planner's margin.
 pub fn check_end<const N: usize>(
     scene: &Scene<N>,
     q: &Joints<f32>,

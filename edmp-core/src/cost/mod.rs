@@ -326,7 +326,7 @@ impl Pulls {
 /// result is the same bits as a full evaluation (such a unit adds no volume and no pull).
 /// Between the guidance steps at one `t` a waypoint with a zero gradient does not move, so in
 /// a cluttered scene many of a row's segments that pass near obstacles without touching them
-/// are skipped (docs/benchmark.md, sixth session, for what that is worth where).
+/// are skipped (docs/benchmark.md measures what that is worth where).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CostMemo {
     /// The configuration of the last evaluation; `None`: nothing is known (every unit runs).

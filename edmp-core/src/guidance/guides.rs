@@ -1,6 +1,6 @@
 //! EDMP's ensemble of guides as data: one row per guide, each a cost kind and three schedules
 //! over the diffusion step t (clearance c(t), expansion e(t), step size s(t)) plus whether its
-//! gradient is normalized. The table is the original's `cfg1` (shared/notes/edmp-reference.md §3:
+//! gradient is normalized. The table is the original's `cfg1` (the original implementation, vishal-2000/EDMP:
 //! guides 1-5, 10, 11, 13, 14, 16, 18, 21); the planner reads it, it holds no code.
 
 use crate::cost::CostKind;

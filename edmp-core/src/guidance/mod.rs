@@ -2,7 +2,7 @@
 //!
 //! Rows `g·k … g·k + k − 1` follow guide `g` (k = rows / guides, as the original lays out its
 //! batch). Each gradient is taken at the row clipped to the hard joint limits and applied to the
-//! unclipped row, interior waypoints only (shared/notes/edmp-reference.md §3). Normalized guides
+//! unclipped row, interior waypoints only (the original implementation, vishal-2000/EDMP). Normalized guides
 //! divide by the norm of their own k rows' gradient and skip the step when it is zero: the
 //! original's batch-wide norm couples guides and turns an all-zero gradient into NaN. A step
 //! limit per joint keeps the unnormalized guides (whose step is the raw gradient times ~2)

@@ -54,16 +54,16 @@ pub struct PlanConfig {
     pub condition: bool,
     /// Gradient steps of every guide after the last denoising step, with each guide's schedule
     /// at t = 1 (no expansion, its own clearance and step size): a deviation from the original,
-    /// which stops at the last denoising step; measured in the README.
+    /// which stops at the last denoising step; measured in docs/benchmark.md.
     pub refine: u8,
     /// Largest move of one joint of one waypoint in one gradient step, radians
     /// (`f32::INFINITY`: the original, unlimited). A deviation: unlimited, the unnormalized
-    /// swept-volume guide (10) throws trajectories across the workspace; measured in the README.
+    /// swept-volume guide (10) throws trajectories across the workspace; measured in docs/benchmark.md.
     pub step_limit: f32,
     /// How cylinders are boxed for the costs.
     pub cylinder: CylinderBox,
     /// The frame the costs box each obstacle and robot box pair in (a deviation from the
-    /// original's world AABBs, measured in the README).
+    /// original's world AABBs, measured in docs/benchmark.md).
     pub frame: BoxFrame,
     /// The exact checker's settings for the final judgement.
     pub check: CheckConfig,
@@ -182,7 +182,7 @@ impl PlanConfig {
             .ok_or(Error::BadParameter)
     }
 
-    /// The shipped configuration, picked from the suite measurements in the README: the
+    /// The shipped configuration, picked from the suite measurements in docs/benchmark.md: the
     /// strided sampler with [`DEFAULT_STEPS`] steps, [`DEFAULT_GRADIENT_STEPS`] gradient steps
     /// after each, [`DEFAULT_REFINE_STEPS`] refinement steps, moves limited to
     /// [`DEFAULT_STEP_LIMIT`], enclosing boxes for cylinders, obstacle-frame boxes, the
@@ -237,7 +237,7 @@ pub struct GlobalConfig {
 }
 
 impl GlobalConfig {
-    /// The shipped setting (measured in the README and docs/benchmark.md).
+    /// The shipped setting (measured in docs/benchmark.md).
     pub const DEFAULT: Self = Self {
         search: SearchConfig::DEFAULT,
         attempts: 4,

@@ -753,7 +753,7 @@ fn check_within_limits(q: &Joints<f32>) -> Result<(), Error> {
     }
 }
 
-/// How far outside the soft limits an end may lie (`spec/formats.md`).
+/// How far outside the soft limits an end may lie (docs/formats.md).
 const LIMIT_TOLERANCE: f32 = 1e-5;
 
 /// Uniform in `0..n` for a `usize` bound (`n` fits `u32` here: paths hold < 2^17 points).

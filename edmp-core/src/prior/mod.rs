@@ -3,7 +3,7 @@
 //!
 //! Three samplers share one step interface, so the guided planner can apply its costs between
 //! steps: EDMP's original ancestral sampler (all `STEPS` = 255 steps, noise std β_t, exactly
-//! as shared/notes/edmp-reference.md §1); the same rule on `K` evenly strided steps (the
+//! as the original implementation, vishal-2000/EDMP); the same rule on `K` evenly strided steps (the
 //! strided step's β' = 1 − ᾱ_t/ᾱ_prev), which trades steps for speed; and DDIM (η = 0) on `K`
 //! strided steps, for comparison. All write the start and the goal into the first and last
 //! waypoint after every step.

@@ -72,7 +72,7 @@ pub struct Robot<T> {
     pub hard_lower: [T; JOINTS],
     /// URDF `<limit upper>`.
     pub hard_upper: [T; JOINTS],
-    /// The finger opening an absent `gripper` field means (`spec/formats.md`): 0.025 m.
+    /// The finger opening an absent `gripper` field means (docs/formats.md): 0.025 m.
     pub finger_default: T,
     /// Smallest finger opening (the driving finger joint's `<limit lower>`).
     pub finger_lower: T,

@@ -7,9 +7,10 @@
 //! - `success.png` (success per family) and `time.png` (distribution of planning times).
 
 use crate::Failure;
-use crate::commands::plan::{Tuning, chosen_guides, plan_problem_on};
+use crate::commands::plan::Tuning;
 use crate::formats::json::{Goal, parse_problem};
 use crate::metrics::{Roughness, acsm, path_length, roughness};
+use crate::planning::{chosen_guides, plan_problem_on};
 use crate::plots;
 use core::time::Duration;
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};

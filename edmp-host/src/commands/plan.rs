@@ -1,34 +1,24 @@
 //! `edmp-host plan`: EDMP on one `edmp-scene/1` file, written as an `edmp-plan/1` plan
-//! (`shared/spec/formats.md`). Exit 0: the chosen trajectory passed the exact checker; 1: no
+//! (docs/formats.md). Exit 0: the chosen trajectory passed the exact checker; 1: no
 //! candidate did (the least colliding one is written, status "collision"); 2: bad input,
 //! nothing written.
 
 use crate::Failure;
-use crate::formats::json::{Problem, joint_goal, parse_problem};
-use crate::formats::trajectory::{TimedArgs, TimedRequest, trajectory_document};
-use crate::threads::Threads;
-use edmp_core::cost::boxes::{BoxFrame, Inflation};
-use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
-use edmp_core::executor::{Executor, Serial};
-use edmp_core::guidance::guides::{CLEARANCE_GUIDE, EDMP_GUIDES, Guide, Schedule};
+use crate::formats::json::parse_problem;
+use crate::formats::plan::{add_trajectory, plan_document};
+use crate::formats::trajectory::TimedArgs;
+use crate::planning::{chosen_guides, plan_problem_on};
+use edmp_core::cost::boxes::BoxFrame;
+use edmp_core::guidance::guides::{CLEARANCE_GUIDE, Guide, Schedule};
 use edmp_core::planner::GlobalConfig;
 use edmp_core::planner::search::SearchConfig;
 use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Judging,
-    Observer, Phase, Plan, PlanConfig, RefineStop, Request, Workspace, plan_observed,
+    PlanConfig, RefineStop,
 };
-use edmp_core::prior::{Sampler, Scratch};
-use edmp_core::rng::Rng;
-use serde_json::json;
+use edmp_core::prior::Sampler;
 use std::path::PathBuf;
 use std::time::Instant;
-
-/// Rows of the batch: EDMP's 12 guides, one trajectory each.
-pub const ROWS: usize = 12;
-
-/// Nodes per search tree the host's workspace holds (the core's default search takes all of
-/// them, `--search-nodes` fewer; the firmware and `edmp-host embed` hold 512).
-pub const HOST_SEARCH_NODES: usize = 4096;
 
 /// Arguments of `edmp-host plan`.
 #[derive(Debug, clap::Args)]
@@ -384,225 +374,6 @@ impl Tuning {
             )
         }
     }
-}
-
-/// A planned problem and where the time went.
-#[derive(Debug)]
-pub struct Planned {
-    /// Candidates, verdicts, the winner.
-    pub plan: Plan<ROWS>,
-    /// Milliseconds in IK.
-    pub ik_ms: f64,
-    /// Milliseconds in the guided denoising.
-    pub denoise_ms: f64,
-    /// Milliseconds in the selection.
-    pub select_ms: f64,
-    /// Milliseconds in the global stage.
-    pub global_ms: f64,
-    /// Milliseconds shortening the winner.
-    pub shortcut_ms: f64,
-}
-
-impl Planned {
-    /// Planning time in all, milliseconds.
-    pub fn total_ms(&self) -> f64 {
-        self.ik_ms + self.denoise_ms + self.select_ms + self.global_ms + self.shortcut_ms
-    }
-}
-
-/// Plans a parsed problem: IK for a pose goal, then the core planner with `ROWS` rows.
-pub fn plan_problem(problem: &Problem, guides: &[Guide], config: &PlanConfig, seed: u64) -> Result<Planned, Failure> {
-    plan_problem_on(problem, guides, config, seed, 1)
-}
-
-/// [`plan_problem`] on `threads` threads (1: on the calling thread): the same plan, bit for bit.
-pub fn plan_problem_on(
-    problem: &Problem,
-    guides: &[Guide],
-    config: &PlanConfig,
-    seed: u64,
-    threads: usize,
-) -> Result<Planned, Failure> {
-    if threads <= 1 {
-        // Four trajectories per network pass share each weight tile.
-        let mut scratches = vec![Scratch::<4>::new()];
-        return plan_with(&Serial, problem, guides, config, seed, &mut scratches);
-    }
-    let exec = Threads::new(threads).map_err(Failure::Input)?;
-    // Three per pass: the 12 rows split evenly over 2, 4 (or 3) threads.
-    let mut scratches: Vec<Scratch<3>> = (0..threads.min(ROWS)).map(|_| Scratch::new()).collect();
-    plan_with(&exec, problem, guides, config, seed, &mut scratches)
-}
-
-fn plan_with<E: Executor, const C: usize>(
-    exec: &E,
-    problem: &Problem,
-    guides: &[Guide],
-    config: &PlanConfig,
-    seed: u64,
-    scratches: &mut [Scratch<C>],
-) -> Result<Planned, Failure> {
-    let ik_began = Instant::now();
-    let goal = joint_goal(problem).map_err(Failure::Input)?;
-    let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
-    let mut work = Box::new(Workspace::<ROWS, HOST_SEARCH_NODES>::new());
-    let req = Request {
-        scene: &problem.scene,
-        start: &problem.start,
-        goal: &goal,
-        guides,
-        config,
-    };
-    let mut stopwatch = Stopwatch::default();
-    let plan = plan_observed(exec, &req, &mut Rng::new(seed), scratches, &mut work, &mut stopwatch)
-        .map_err(|e| Failure::Input(format!("planner: {e}")))?;
-    let [denoise_ms, select_ms, global_ms, shortcut_ms] = stopwatch.ms;
-    Ok(Planned {
-        plan,
-        ik_ms,
-        denoise_ms,
-        select_ms,
-        global_ms,
-        shortcut_ms,
-    })
-}
-
-/// Milliseconds in each [`Phase`] of the core's pipeline, in its order.
-#[derive(Default)]
-struct Stopwatch {
-    began: Option<Instant>,
-    ms: [f64; 4],
-}
-
-impl Observer for Stopwatch {
-    fn begin(&mut self, _: Phase) {
-        self.began = Some(Instant::now());
-    }
-
-    fn end(&mut self, phase: Phase) {
-        let slot = match phase {
-            Phase::FirstStage => 0,
-            Phase::Judge => 1,
-            Phase::GlobalStage => 2,
-            Phase::Shortcut => 3,
-        };
-        if let Some(began) = self.began.take() {
-            self.ms[slot] += began.elapsed().as_secs_f64() * 1e3;
-        }
-    }
-}
-
-/// The guides named on the command line (all of EDMP's when none).
-pub fn chosen_guides(ids: &[u8]) -> Result<Vec<Guide>, Failure> {
-    if ids.is_empty() {
-        return Ok(EDMP_GUIDES.to_vec());
-    }
-    let mut out = Vec::new();
-    for id in ids {
-        let guide = EDMP_GUIDES.iter().find(|g| g.id == *id).ok_or_else(|| {
-            let known: Vec<String> = EDMP_GUIDES.iter().map(|g| g.id.to_string()).collect();
-            Failure::Input(format!("--guides: no guide {id} (EDMP's are {})", known.join(", ")))
-        })?;
-        out.push(*guide);
-    }
-    if !ROWS.is_multiple_of(out.len()) {
-        return Err(Failure::Input(format!(
-            "--guides: {} guides do not divide the {ROWS} rows",
-            out.len()
-        )));
-    }
-    Ok(out)
-}
-
-/// The `edmp-plan/1` document of a planned problem (`spec/formats.md`): the one writer of the
-/// format, which the CLI and the Python package share. `total_ms` is the caller's wall time.
-pub fn plan_document(
-    problem: &Problem,
-    planned: &Planned,
-    guides: &[Guide],
-    config: &PlanConfig,
-    seed: u64,
-    candidates: bool,
-    total_ms: f64,
-) -> Result<serde_json::Value, Failure> {
-    let plan = &planned.plan;
-    let best = &plan.paths[plan.best];
-    let iv = CostConfig {
-        kind: CostKind::Intersection,
-        inflation: Inflation::default(),
-        cylinder: config.cylinder,
-        frame: config.frame,
-    };
-    let intersection = trajectory_cost(&problem.scene, best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
-    let per_guide = ROWS / guides.len();
-    let guide_of = |row: usize| guides[row / per_guide].id;
-    let status = if plan.is_free() { "success" } else { "collision" };
-    let mut out = json!({
-        "format": "edmp-plan/1",
-        "status": status,
-        "waypoints": best.iter().map(|q| q.to_vec()).collect::<Vec<_>>(),
-        "guide": guide_of(plan.best),
-        "stage": plan.stage.name(),
-        "search": plan.search.map(|s| json!({
-            "found": s.found,
-            "nodes": s.nodes,
-            "iterations": s.iterations,
-            "attempts": s.attempts,
-            "segment_checks": s.segment_checks,
-        })),
-        "shortcut": plan.shortcut.map(|s| json!({
-            "length_before": s.length_before,
-            "length_after": s.length_after,
-            "dropped": s.dropped,
-            "smoothing": s.smoothing,
-        })),
-        "costs": {"swept_volume": plan.verdicts[plan.best].swept, "intersection_volume": intersection},
-        "seed": seed,
-        "timing_ms": {
-            "total": total_ms,
-            "ik": planned.ik_ms,
-            "denoise": planned.denoise_ms,
-            "select": planned.select_ms,
-            "global": planned.global_ms,
-            "shortcut": planned.shortcut_ms,
-        },
-    });
-    if candidates {
-        out["candidates"] = plan
-            .paths
-            .iter()
-            .zip(&plan.verdicts)
-            .enumerate()
-            .filter(|(_, (_, verdict))| verdict.made)
-            .map(|(row, (path, verdict))| {
-                json!({
-                    "guide": guide_of(row),
-                    "collision_free": verdict.free,
-                    "swept_volume": verdict.swept,
-                    "waypoints": path.iter().map(|q| q.to_vec()).collect::<Vec<_>>(),
-                })
-            })
-            .collect();
-    }
-    Ok(out)
-}
-
-/// Adds the `trajectory` field (and `timing_ms.trajectory`) to a plan document when the plan
-/// is free; `false` when it collides (a colliding path is not timed).
-pub fn add_trajectory(
-    doc: &mut serde_json::Value,
-    problem: &Problem,
-    plan: &Plan<ROWS>,
-    config: &PlanConfig,
-    request: &TimedRequest,
-) -> Result<bool, Failure> {
-    let Some(path) = plan.paths.get(plan.best).filter(|_| plan.is_free()) else {
-        return Ok(false);
-    };
-    let began = Instant::now();
-    doc["trajectory"] = trajectory_document(&problem.scene, path, &config.check, request)?;
-    doc["timing_ms"]["trajectory"] = json!(began.elapsed().as_secs_f64() * 1e3);
-    Ok(true)
 }
 
 /// Plans and writes the plan.

@@ -6,7 +6,8 @@
 //! colour per collision-free candidate, grey for colliding ones.
 //! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
 
-use crate::formats::json::{Goal, parse_plan, parse_problem};
+use crate::formats::json::{Goal, parse_problem};
+use crate::formats::plan::parse_plan;
 use edmp_core::collision::convex::{Convex, Solid};
 use edmp_core::robot::kinematics::{Joints, forward, forward_with};
 use edmp_core::robot::{BODIES, PANDA};

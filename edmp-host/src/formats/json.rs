@@ -18,7 +18,7 @@ pub struct InputError {
 }
 
 impl InputError {
-    fn at(path: &str, message: impl Into<String>) -> Self {
+    pub(crate) fn at(path: &str, message: impl Into<String>) -> Self {
         Self {
             path: path.to_string(),
             message: message.into(),
@@ -86,7 +86,7 @@ fn object<'a>(v: &'a Value, path: &str, allowed: &[&str]) -> Result<&'a Map<Stri
     Ok(map)
 }
 
-fn field<'a>(map: &'a Map<String, Value>, path: &str, key: &str) -> Result<(&'a Value, String), InputError> {
+pub(crate) fn field<'a>(map: &'a Map<String, Value>, path: &str, key: &str) -> Result<(&'a Value, String), InputError> {
     let at = if path.is_empty() {
         key.to_string()
     } else {
@@ -97,7 +97,7 @@ fn field<'a>(map: &'a Map<String, Value>, path: &str, key: &str) -> Result<(&'a 
         .ok_or_else(|| InputError::at(&at, "missing"))
 }
 
-fn number(v: &Value, path: &str) -> Result<f32, InputError> {
+pub(crate) fn number(v: &Value, path: &str) -> Result<f32, InputError> {
     let x = v
         .as_f64()
         .ok_or_else(|| InputError::at(path, format!("expected a number, found {v}")))?;
@@ -108,7 +108,7 @@ fn number(v: &Value, path: &str) -> Result<f32, InputError> {
     Ok(y)
 }
 
-fn numbers<const K: usize>(v: &Value, path: &str) -> Result<[f32; K], InputError> {
+pub(crate) fn numbers<const K: usize>(v: &Value, path: &str) -> Result<[f32; K], InputError> {
     let items = v
         .as_array()
         .ok_or_else(|| InputError::at(path, format!("expected an array of {K} numbers")))?;
@@ -366,136 +366,6 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
     })
 }
 
-/// One alternative path of a plan written with `--candidates`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PlanCandidate {
-    /// The guide that steered it.
-    pub guide: Option<u64>,
-    /// Whether the checker passed it.
-    pub collision_free: bool,
-    /// Its waypoints.
-    pub waypoints: Vec<Joints<f32>>,
-}
-
-/// An `edmp-plan/1` document as read back (by `edmp-host view`): the chosen path, its timed
-/// trajectory, the candidates and the report fields. Fields it does not use are not checked.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PlanDocument {
-    /// `"success"` or `"collision"`.
-    pub status: String,
-    /// The stage that found the path (`diffusion`, `reseeded`, `search`), when written.
-    pub stage: Option<String>,
-    /// The chosen path.
-    pub waypoints: Vec<Joints<f32>>,
-    /// `trajectory.points` as (time from start in seconds, joint positions), when timed.
-    pub trajectory: Vec<(f32, Joints<f32>)>,
-    /// `candidates`, empty when the plan was written without them.
-    pub candidates: Vec<PlanCandidate>,
-    /// `timing_ms`: every stage's milliseconds, by name.
-    pub timing_ms: Vec<(String, f64)>,
-}
-
-fn path_of(v: &Value, path: &str) -> Result<Vec<Joints<f32>>, InputError> {
-    let rows = v
-        .as_array()
-        .ok_or_else(|| InputError::at(path, "expected an array of waypoints"))?;
-    if rows.is_empty() {
-        return Err(InputError::at(path, "no waypoints"));
-    }
-    rows.iter()
-        .enumerate()
-        .map(|(i, row)| numbers::<JOINTS>(row, &format!("{path}[{i}]")))
-        .collect()
-}
-
-/// Parses an `edmp-plan/1` document (what `edmp-host plan` writes) for reading back.
-pub fn parse_plan(text: &str) -> Result<PlanDocument, InputError> {
-    let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
-    let map = root
-        .as_object()
-        .ok_or_else(|| InputError::at("", "expected an object"))?;
-    let (format, fp) = field(map, "", "format")?;
-    if format.as_str() != Some("edmp-plan/1") {
-        return Err(InputError::at(&fp, format!("expected \"edmp-plan/1\", found {format}")));
-    }
-    let (status, sp) = field(map, "", "status")?;
-    let status = status
-        .as_str()
-        .ok_or_else(|| InputError::at(&sp, format!("expected a string, found {status}")))?
-        .to_string();
-    let stage = map.get("stage").and_then(Value::as_str).map(str::to_string);
-    let (waypoints, wp) = field(map, "", "waypoints")?;
-    let waypoints = path_of(waypoints, &wp)?;
-    let mut trajectory = Vec::new();
-    if let Some(t) = map.get("trajectory") {
-        let tm = t
-            .as_object()
-            .ok_or_else(|| InputError::at("trajectory", "expected an object"))?;
-        let (points, pp) = field(tm, "trajectory", "points")?;
-        let points = points
-            .as_array()
-            .ok_or_else(|| InputError::at(&pp, "expected an array"))?;
-        if points.is_empty() {
-            return Err(InputError::at(&pp, "no points"));
-        }
-        for (i, point) in points.iter().enumerate() {
-            let at = format!("{pp}[{i}]");
-            let pm = point
-                .as_object()
-                .ok_or_else(|| InputError::at(&at, "expected an object"))?;
-            let (q, qp) = field(pm, &at, "positions")?;
-            let (time, tp) = field(pm, &at, "time_from_start")?;
-            let time = number(time, &tp)?;
-            if trajectory.last().is_some_and(|&(before, _)| time < before) {
-                return Err(InputError::at(
-                    &tp,
-                    format!("{time} is before the previous point's time"),
-                ));
-            }
-            trajectory.push((time, numbers::<JOINTS>(q, &qp)?));
-        }
-    }
-    let mut candidates = Vec::new();
-    if let Some(list) = map.get("candidates") {
-        let list = list
-            .as_array()
-            .ok_or_else(|| InputError::at("candidates", "expected an array"))?;
-        for (i, c) in list.iter().enumerate() {
-            let at = format!("candidates[{i}]");
-            let cm = c.as_object().ok_or_else(|| InputError::at(&at, "expected an object"))?;
-            let (w, wp) = field(cm, &at, "waypoints")?;
-            let (free, fp) = field(cm, &at, "collision_free")?;
-            candidates.push(PlanCandidate {
-                guide: cm.get("guide").and_then(Value::as_u64),
-                collision_free: free
-                    .as_bool()
-                    .ok_or_else(|| InputError::at(&fp, format!("expected true or false, found {free}")))?,
-                waypoints: path_of(w, &wp)?,
-            });
-        }
-    }
-    let mut timing_ms = Vec::new();
-    if let Some(t) = map.get("timing_ms") {
-        let tm = t
-            .as_object()
-            .ok_or_else(|| InputError::at("timing_ms", "expected an object"))?;
-        for (key, value) in tm {
-            let ms = value.as_f64().ok_or_else(|| {
-                InputError::at(&format!("timing_ms.{key}"), format!("expected a number, found {value}"))
-            })?;
-            timing_ms.push((key.clone(), ms));
-        }
-    }
-    Ok(PlanDocument {
-        status,
-        stage,
-        waypoints,
-        trajectory,
-        candidates,
-        timing_ms,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -614,38 +484,5 @@ mod tests {
         let closed = parse_problem(&doc(0.0)).unwrap_err().to_string();
         assert!(closed.starts_with("start: in collision: panda_"), "{closed}");
         assert!(closed.contains("finger touches obstacles[0]"), "{closed}");
-    }
-
-    #[test]
-    fn plan_errors_name_the_field() {
-        let q = "[0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785]";
-        let plan =
-            |rest: &str| format!(r#"{{"format": "edmp-plan/1", "status": "success", "waypoints": [{q}, {q}]{rest}}}"#);
-        let ok = parse_plan(&plan(r#", "timing_ms": {"total": 1.5}"#)).unwrap();
-        assert_eq!(
-            (ok.waypoints.len(), ok.timing_ms.clone()),
-            (2, vec![("total".to_string(), 1.5)])
-        );
-        let error = |text: &str| parse_plan(text).unwrap_err().to_string();
-        assert_eq!(
-            error(&plan("").replace("plan/1", "scene/1")),
-            r#"format: expected "edmp-plan/1", found "edmp-scene/1""#
-        );
-        let timed = format!(
-            r#", "trajectory": {{"points": [{{"positions": {q}, "time_from_start": 0.5}}, {{"positions": {q}, "time_from_start": 0.25}}]}}"#
-        );
-        assert_eq!(
-            error(&plan(&timed)),
-            "trajectory.points[1].time_from_start: 0.25 is before the previous point's time"
-        );
-        let candidate = format!(r#", "candidates": [{{"collision_free": "yes", "waypoints": [{q}]}}]"#);
-        assert_eq!(
-            error(&plan(&candidate)),
-            r#"candidates[0].collision_free: expected true or false, found "yes""#
-        );
-        assert_eq!(
-            error(&plan("").replace(&format!("[{q}, {q}]"), "[]")),
-            "waypoints: no waypoints"
-        );
     }
 }

@@ -1,5 +1,5 @@
 //! `--timed`: the chosen path as a time-stamped trajectory, the `trajectory` field of
-//! `edmp-plan/1` (`spec/formats.md`), shaped like ROS `trajectory_msgs/JointTrajectory`.
+//! `edmp-plan/1` (docs/formats.md), shaped like ROS `trajectory_msgs/JointTrajectory`.
 //!
 //! The core times the path (`edmp_core::trajectory`): a cubic B-spline over the waypoints,
 //! checked with the planner's checker (or the exact polyline when the spline touches

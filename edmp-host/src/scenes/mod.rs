@@ -1,5 +1,5 @@
 //! MpiNets-style scene families and their planning problems (numbers from
-//! `shared/notes/mpinets-scenes.md`; simplifications are said where they are made).
+//! MpiNets' scene generation, NVlabs/motion-policy-networks; simplifications are said where they are made).
 //!
 //! A generator returns obstacles plus the volumes where the gripper may be asked to go; a
 //! problem is then a start and a goal (task-oriented: both poses in those volumes; neutral
@@ -293,7 +293,7 @@ impl Environment {
     }
 }
 
-/// MpiNets' neutral configuration (robofin `FrankaRobot.NEUTRAL`, shared/notes).
+/// MpiNets' neutral configuration (robofin `FrankaRobot.NEUTRAL`).
 pub(crate) const NEUTRAL: Joints<f32> = [-0.0178, -0.7601, 0.0198, -2.3421, 0.0298, 1.5412, 0.7534];
 
 /// The three MpiNets problem kinds.

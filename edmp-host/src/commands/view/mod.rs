@@ -8,7 +8,8 @@
 //! at those poses and interpolates between samples; it computes no kinematics.
 
 use crate::Failure;
-use crate::formats::json::{Goal, PlanDocument, Problem, parse_plan, parse_problem};
+use crate::formats::json::{Goal, Problem, parse_problem};
+use crate::formats::plan::{PlanDocument, parse_plan};
 use edmp_core::robot::kinematics::{Joints, Pose, forward_with};
 use edmp_core::robot::{FRAME_NAMES, FRAMES, HAND_FRAME, TCP_FRAME};
 use edmp_core::scene::{Obstacle, Shape};
