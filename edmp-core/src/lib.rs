@@ -14,6 +14,7 @@
 //! ```
 #![no_std]
 #![deny(missing_docs)]
+#![forbid(unsafe_code)]
 
 #[cfg(test)]
 extern crate std;

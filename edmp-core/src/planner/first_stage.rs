@@ -6,9 +6,10 @@ use crate::error::Error;
 use crate::executor::{Executor, Serial};
 use crate::path::Path;
 use crate::planner::refine::{guide_steps, refine};
+use crate::planner::request::Request;
 use crate::planner::waves::in_waves;
+use crate::planner::workspace::Workspace;
 use crate::planner::workspace::{WaveChecks, WaveRows};
-use crate::planner::{Request, Workspace};
 use crate::prior::{Scratch, TimeEmbedding, check_joints, free_ends, initial_noise, inpaint, predict_noise_on};
 use crate::rng::Rng;
 

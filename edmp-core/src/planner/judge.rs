@@ -9,7 +9,10 @@ use crate::cost::{CostConfig, CostKind, trajectory_cost};
 use crate::error::Error;
 use crate::executor::Executor;
 use crate::path::{HORIZON, Path};
-use crate::planner::{Judging, Plan, Request, RowChecks, Stage, Verdict};
+use crate::planner::config::Judging;
+use crate::planner::plan::{Plan, Stage, Verdict};
+use crate::planner::request::Request;
+use crate::planner::workspace::RowChecks;
 use crate::robot::kinematics::Joints;
 use crate::robot::{JOINTS, PANDA};
 

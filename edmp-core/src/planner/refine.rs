@@ -8,9 +8,10 @@ use crate::executor::Executor;
 use crate::guidance::guides::Guide;
 use crate::guidance::{GuideStep, StepControl, StepRule, guide_step_controlled, guide_step_on};
 use crate::path::Path;
+use crate::planner::config::{PlanConfig, STALL_RATIO};
 use crate::planner::judge::certify;
+use crate::planner::request::Request;
 use crate::planner::workspace::{WaveChecks, WaveRows};
-use crate::planner::{PlanConfig, Request, STALL_RATIO};
 
 /// `steps` gradient steps of every row's guide at diffusion step `t`, with the plan's step limit
 /// and boxes (the first stage's and the global stage's guidance alike). A guide whose rows stop

@@ -1,7 +1,7 @@
 //! One planning request: what every stage of the pipeline reads and none of them changes.
 
 use crate::guidance::guides::Guide;
-use crate::planner::PlanConfig;
+use crate::planner::config::PlanConfig;
 use crate::robot::kinematics::Joints;
 use crate::scene::Scene;
 

@@ -8,21 +8,12 @@
 //! strided steps, for comparison. All write the start and the goal into the first and last
 //! waypoint after every step.
 
+mod layers;
 mod net;
+mod weights;
 
-#[allow(
-    missing_docs,
-    unreachable_pub,
-    clippy::unreadable_literal,
-    clippy::excessive_precision
-)]
-mod generated {
-    use super::net::{Aligned, Conv, ConvBlock, Down, Linear, Net, ResBlock, Up, slice_of};
-    include!(concat!(env!("OUT_DIR"), "/prior.rs"));
-}
-
-pub use generated::{DIMS, LENGTHS, LEVELS, MACS, PARAMETERS, STEPS, WEIGHT_BYTES, WEIGHTS_FNV1A};
 pub use net::{Scratch, TimeEmbedding, predict_noise, predict_noise_on};
+pub use weights::{DIMS, LENGTHS, LEVELS, MACS, PARAMETERS, STEPS, WEIGHT_BYTES, WEIGHTS_FNV1A};
 
 use crate::Error;
 use crate::path::{HORIZON, Path};
@@ -31,14 +22,14 @@ use crate::robot::JOINTS;
 
 // The network must have been trained on this robot's joints and the planner's horizon.
 const _: () = assert!(
-    generated::JOINTS == JOINTS,
+    weights::JOINTS == JOINTS,
     "weights/prior was trained for another joint count"
 );
 const _: () = assert!(LENGTHS[0] == HORIZON, "weights/prior was trained for another horizon");
 
 /// The weight blob the build embedded: `include_bytes!` of the codegen output.
 pub fn weight_blob() -> &'static [u8] {
-    generated::WEIGHT_BLOB
+    weights::WEIGHT_BLOB
 }
 
 /// Whether the embedded weights still hash to the checksum codegen computed (flash check).
@@ -129,11 +120,7 @@ impl Sampler {
         let i = table_index(step.t);
         match *self {
             Self::Ancestral => {
-                let (a, c, sigma) = (
-                    generated::SQRT_RECIP_ALPHA[i],
-                    generated::EPS_COEF[i],
-                    generated::BETA[i],
-                );
+                let (a, c, sigma) = (weights::SQRT_RECIP_ALPHA[i], weights::EPS_COEF[i], weights::BETA[i]);
                 for (xw, ew) in x.iter_mut().zip(eps) {
                     for (xv, ev) in xw.iter_mut().zip(ew) {
                         let z = if step.t > 1 { rng.normal_f32() } else { 0.0 };
@@ -145,14 +132,14 @@ impl Sampler {
                 let abar = |t: u16| match t {
                     0 => 1.0,
                     t => {
-                        let s = generated::SQRT_ALPHA_BAR[table_index(t)];
+                        let s = weights::SQRT_ALPHA_BAR[table_index(t)];
                         s * s
                     }
                 };
                 let beta = 1.0 - abar(step.t) / abar(step.prev);
                 let (a, c) = (
                     1.0 / crate::float::sqrt(1.0 - beta),
-                    beta / generated::SQRT_ONE_MINUS_ALPHA_BAR[i],
+                    beta / weights::SQRT_ONE_MINUS_ALPHA_BAR[i],
                 );
                 for (xw, ew) in x.iter_mut().zip(eps) {
                     for (xv, ev) in xw.iter_mut().zip(ew) {
@@ -162,12 +149,12 @@ impl Sampler {
                 }
             }
             Self::Ddim { .. } => {
-                let (sa, sn) = (generated::SQRT_ALPHA_BAR[i], generated::SQRT_ONE_MINUS_ALPHA_BAR[i]);
+                let (sa, sn) = (weights::SQRT_ALPHA_BAR[i], weights::SQRT_ONE_MINUS_ALPHA_BAR[i]);
                 let (pa, pn) = match step.prev {
                     0 => (1.0, 0.0),
                     p => {
                         let p = table_index(p);
-                        (generated::SQRT_ALPHA_BAR[p], generated::SQRT_ONE_MINUS_ALPHA_BAR[p])
+                        (weights::SQRT_ALPHA_BAR[p], weights::SQRT_ONE_MINUS_ALPHA_BAR[p])
                     }
                 };
                 for (xw, ew) in x.iter_mut().zip(eps) {
@@ -205,7 +192,7 @@ impl Step {
 /// prior at an intermediate step (SDEdit), to be denoised from there.
 pub fn diffuse(x: &mut Path, t: u16, rng: &mut Rng, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
     let i = table_index(t);
-    let (a, n) = (generated::SQRT_ALPHA_BAR[i], generated::SQRT_ONE_MINUS_ALPHA_BAR[i]);
+    let (a, n) = (weights::SQRT_ALPHA_BAR[i], weights::SQRT_ONE_MINUS_ALPHA_BAR[i]);
     for v in x.iter_mut().flatten() {
         *v = a * *v + n * rng.normal_f32();
     }

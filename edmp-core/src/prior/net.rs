@@ -11,7 +11,8 @@
 //! register tiles of 4 channels × 8 positions without branches, and only the row's end wastes
 //! work.
 
-use super::generated::{DIMS, GROUPS, KERNEL, LENGTHS, LEVELS, NET, TIME_DIM, TIME_HIDDEN, TOP_SKIP};
+use super::layers::{Conv, ConvBlock, Linear, ResBlock};
+use super::weights::{DIMS, GROUPS, KERNEL, LENGTHS, LEVELS, NET, STEPS, TIME_DIM, TIME_HIDDEN, TOP_SKIP};
 use crate::Error;
 use crate::executor::{Executor, MAX_PARTS, split};
 use crate::path::Trajectory;
@@ -98,76 +99,6 @@ impl Layout {
     }
 }
 
-/// Keeps the weight blob at a 16-byte boundary (SIMD loads on the target).
-#[repr(C, align(16))]
-pub(crate) struct Aligned<B: ?Sized>(pub(crate) B);
-
-/// `blob[offset..offset + len]` in a constant context (out of range fails the build).
-pub(crate) const fn slice_of(blob: &'static [u8], offset: usize, len: usize) -> &'static [u8] {
-    let (_, rest) = blob.split_at(offset);
-    rest.split_at(len).0
-}
-
-/// A 1-D convolution, output-channel-major int8 weights `cout × cin × k`.
-pub(crate) struct Conv {
-    pub(crate) cin: usize,
-    pub(crate) cout: usize,
-    pub(crate) k: usize,
-    pub(crate) weights: &'static [u8],
-    pub(crate) scale: &'static [f32],
-    pub(crate) bias: &'static [f32],
-}
-
-/// A dense layer, int8 weights `fout × fin`.
-pub(crate) struct Linear {
-    pub(crate) fin: usize,
-    pub(crate) fout: usize,
-    pub(crate) weights: &'static [u8],
-    pub(crate) scale: &'static [f32],
-    pub(crate) bias: &'static [f32],
-}
-
-/// Conv → GroupNorm → Mish.
-pub(crate) struct ConvBlock {
-    pub(crate) conv: Conv,
-    pub(crate) gamma: &'static [f32],
-    pub(crate) beta: &'static [f32],
-}
-
-/// Two conv blocks, the time embedding added after the first, residual 1×1 when widths differ.
-pub(crate) struct ResBlock {
-    pub(crate) block0: ConvBlock,
-    pub(crate) block1: ConvBlock,
-    pub(crate) time: Linear,
-    pub(crate) residual: Option<Conv>,
-}
-
-/// A level of the contracting path; `sample` (stride 2) is absent on the last.
-pub(crate) struct Down {
-    pub(crate) res0: ResBlock,
-    pub(crate) res1: ResBlock,
-    pub(crate) sample: Option<Conv>,
-}
-
-/// A level of the expanding path; `sample` is a transposed convolution (k 4, stride 2, pad 1).
-pub(crate) struct Up {
-    pub(crate) res0: ResBlock,
-    pub(crate) res1: ResBlock,
-    pub(crate) sample: Conv,
-}
-
-/// The whole network.
-pub(crate) struct Net {
-    pub(crate) time_in: Linear,
-    pub(crate) time_out: Linear,
-    pub(crate) down: &'static [Down],
-    pub(crate) mid0: ResBlock,
-    pub(crate) mid1: ResBlock,
-    pub(crate) up: &'static [Up],
-    pub(crate) final_block: ConvBlock,
-    pub(crate) out: Conv,
-}
-
 /// Mish of the time embedding of step `t`: what every residual block projects.
 /// Depends on `t` alone, so a batch computes it once per step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -179,7 +110,7 @@ pub struct TimeEmbedding {
 impl TimeEmbedding {
     /// The embedding of step `t` (1 ..= `STEPS`, as the network was trained).
     pub fn new(t: u16) -> Result<Self, Error> {
-        if t == 0 || usize::from(t) > super::STEPS {
+        if t == 0 || usize::from(t) > STEPS {
             return Err(Error::BadParameter);
         }
         let half = TIME_DIM / 2;

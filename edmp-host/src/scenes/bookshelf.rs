@@ -4,7 +4,7 @@
 //! up (the hand level, entering from the open front); task-oriented starts are in another
 //! gap or in front of the shelf.
 
-use super::{Approach, Environment, Frame, clutter};
+use super::environment::{Approach, Environment, Frame, clutter};
 use edmp_core::rng::Rng;
 
 /// Gaps whose middle is higher than this are out of the arm's comfortable reach.

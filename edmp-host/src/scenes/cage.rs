@@ -4,7 +4,7 @@
 //! side passes between the bars; a few cans and boxes stand at the back of the cage.
 //! Task-oriented starts are above the roof or in front of the bars.
 
-use super::{Approach, Environment, Frame, clutter};
+use super::environment::{Approach, Environment, Frame, clutter};
 use edmp_core::rng::Rng;
 
 pub(super) fn generate(rng: &mut Rng) -> Environment {

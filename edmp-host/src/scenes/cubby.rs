@@ -3,8 +3,9 @@
 //! Merged: two pockets are drawn and the shelf and/or wall between them is removed (MpiNets
 //! keeps it at zero thickness; zero sizes are invalid in our scene format, so it is left out).
 
-use super::{Approach, Environment, Primitive, Region, yaw_quaternion};
+use super::environment::{Approach, Environment, Region, yaw_quaternion};
 use edmp_core::rng::Rng;
+use edmp_core::scene::Primitive;
 
 pub(super) fn generate(rng: &mut Rng, merged: bool) -> Environment {
     let mut pm = |c: f32, r: f32| rng.uniform_f32(c - r, c + r);

@@ -4,8 +4,9 @@
 //! Simplifications: closed drawers are their front panels only (the rest is hidden in the
 //! body); MpiNets' 70 % rejection of start and goal drawers at the same height is not applied.
 
-use super::{Approach, Environment, Primitive, Region, yaw_quaternion};
+use super::environment::{Approach, Environment, Region, yaw_quaternion};
 use edmp_core::rng::Rng;
+use edmp_core::scene::Primitive;
 
 struct Cell {
     x: [f32; 2],

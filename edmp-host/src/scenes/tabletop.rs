@@ -3,8 +3,9 @@
 //! Simplifications: an object's clearance to the others is measured between bounding circles
 //! of their footprints (MpiNets uses the exact SDF); pose regions are clipped to the arm's reach.
 
-use super::{Approach, Environment, Primitive, Region, yaw_quaternion};
+use super::environment::{Approach, Environment, Region, yaw_quaternion};
 use edmp_core::rng::Rng;
+use edmp_core::scene::Primitive;
 
 /// Beyond this distance from the base the Panda's TCP cannot go; regions are clipped to it.
 const REACH: f32 = 0.85;

@@ -3,7 +3,7 @@
 //! it at the back. Goals are under the top, just past its front edge, the hand level;
 //! task-oriented starts are above the top or beside the table (where that is within reach).
 
-use super::{Approach, Environment, Frame, clutter};
+use super::environment::{Approach, Environment, Frame, clutter};
 use edmp_core::rng::Rng;
 
 /// Regions whose middle is farther than this from the base are dropped.

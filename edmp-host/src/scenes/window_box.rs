@@ -4,7 +4,7 @@
 //! (per scene); cans and boxes stand on the box's floor behind them. Task-oriented starts are
 //! above the box or in front of the window.
 
-use super::{Approach, Environment, Frame, clutter};
+use super::environment::{Approach, Environment, Frame, clutter};
 use edmp_core::rng::Rng;
 
 pub(super) fn generate(rng: &mut Rng) -> Environment {

@@ -1,0 +1,14 @@
+//! The trained network, frozen at build time: `edmp-codegen` writes `OUT_DIR/prior.rs` (the
+//! layer table, the schedule, the checksum) and `OUT_DIR/prior.bin` (the int8 weights) from
+//! `weights/prior/`.
+
+#![allow(
+    missing_docs,
+    unreachable_pub,
+    clippy::unreadable_literal,
+    clippy::excessive_precision
+)]
+
+use super::layers::{Aligned, Conv, ConvBlock, Down, Linear, Net, ResBlock, Up, slice_of};
+
+include!(concat!(env!("OUT_DIR"), "/prior.rs"));
