@@ -9,7 +9,7 @@ shared 2-core machine. Standard library only; needs valgrind (callgrind_annotate
 Runs `B plan P -o /dev/null` under `valgrind --tool=callgrind` for every K-th problem (sorted)
 of each family folder, then prints one row per problem and the median of each column: the whole
 plan, and inclusive counts of the network (`predict_noise_on`, or `predict_noise` in older builds), the guidance (`guidance::step_rows`), the
-selection (`judge`), the global stage (`global::rescue`, or its caller `planner::finish`) and the shortening (`shortcut::shorten`, or its caller `planner::polish`),
+selection (`judge`), the global stage (`planner::global::rescue`, or its caller `planner::finish_on`) and the shortening (`shortcut::shorten`, or its caller `planner::polish`),
 and the costs with their gradients (`cost::trajectory_cost_memo`, or `trajectory_cost` in builds before it: the guidance's work, plus the
 judge's swept volumes; a column that does not depend on what the compiler inlined).
 A stage's count is inclusive: the global stage's network and guidance are counted in it too.
