@@ -338,6 +338,20 @@ pub fn bending_gradient<const H: usize>(row: &[Joints<f32>; H]) -> [Joints<f32>;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One step of `guides` at `t`, joints limited to `step_limit`, enclosing boxes compared in
+    /// the obstacle's frame.
+    fn step(guides: &[Guide], t: u16, step_limit: f32) -> GuideStep<'_> {
+        GuideStep {
+            guides,
+            t,
+            rule: StepRule {
+                step_limit,
+                cylinder: CylinderBox::Enclosing,
+                frame: BoxFrame::Obstacle,
+            },
+        }
+    }
     use crate::cost::{CostKind, trajectory_cost};
     use crate::guidance::guides::EDMP_GUIDES;
     use crate::scene::Obstacle;
@@ -390,15 +404,7 @@ mod tests {
                 &scene,
                 &mut rows,
                 &mut grads,
-                &GuideStep {
-                    guides: &[small],
-                    t,
-                    rule: StepRule {
-                        step_limit: f32::INFINITY,
-                        cylinder: CylinderBox::Enclosing,
-                        frame: BoxFrame::Obstacle,
-                    },
-                },
+                &step(&[small], t, f32::INFINITY),
                 &mut [],
             )
             .unwrap();
@@ -485,15 +491,7 @@ mod tests {
             &empty,
             &mut rows,
             &mut grads,
-            &GuideStep {
-                guides: &EDMP_GUIDES,
-                t: 100,
-                rule: StepRule {
-                    step_limit: f32::INFINITY,
-                    cylinder: CylinderBox::Enclosing,
-                    frame: BoxFrame::Obstacle,
-                },
-            },
+            &step(&EDMP_GUIDES, 100, f32::INFINITY),
             &mut [],
         )
         .unwrap();
@@ -526,38 +524,8 @@ mod tests {
         }
         let (mut g1, mut g2) = ([[[0.0; 7]; H]], [[[0.0; 7]; H]]);
         let (mut r1, mut r2) = ([wild], [clipped]);
-        guide_step(
-            &scene,
-            &mut r1,
-            &mut g1,
-            &GuideStep {
-                guides: &[guide],
-                t: 50,
-                rule: StepRule {
-                    step_limit: f32::INFINITY,
-                    cylinder: CylinderBox::Enclosing,
-                    frame: BoxFrame::Obstacle,
-                },
-            },
-            &mut [],
-        )
-        .unwrap();
-        guide_step(
-            &scene,
-            &mut r2,
-            &mut g2,
-            &GuideStep {
-                guides: &[guide],
-                t: 50,
-                rule: StepRule {
-                    step_limit: f32::INFINITY,
-                    cylinder: CylinderBox::Enclosing,
-                    frame: BoxFrame::Obstacle,
-                },
-            },
-            &mut [],
-        )
-        .unwrap();
+        guide_step(&scene, &mut r1, &mut g1, &step(&[guide], 50, f32::INFINITY), &mut []).unwrap();
+        guide_step(&scene, &mut r2, &mut g2, &step(&[guide], 50, f32::INFINITY), &mut []).unwrap();
         assert_eq!(g1, g2);
         assert!(
             g1[0][1..H - 1].iter().flatten().any(|g| *g != 0.0),
@@ -587,22 +555,7 @@ mod tests {
             let mut settled = [false; 2];
             for _ in 0..6 {
                 let flags: &mut [bool] = if tracked { &mut settled } else { &mut [] };
-                guide_step(
-                    &scene,
-                    &mut rows,
-                    &mut grads,
-                    &GuideStep {
-                        guides: &guides,
-                        t: 1,
-                        rule: StepRule {
-                            step_limit: 0.1,
-                            cylinder: CylinderBox::Enclosing,
-                            frame: BoxFrame::Obstacle,
-                        },
-                    },
-                    flags,
-                )
-                .unwrap();
+                guide_step(&scene, &mut rows, &mut grads, &step(&guides, 1, 0.1), flags).unwrap();
             }
             (rows, settled)
         };
@@ -619,21 +572,7 @@ mod tests {
         // One flag per guide or none.
         let mut rows = [through, away];
         let mut grads = [[[0.0; 7]; H]; 2];
-        let err = guide_step(
-            &scene,
-            &mut rows,
-            &mut grads,
-            &GuideStep {
-                guides: &guides,
-                t: 1,
-                rule: StepRule {
-                    step_limit: 0.1,
-                    cylinder: CylinderBox::Enclosing,
-                    frame: BoxFrame::Obstacle,
-                },
-            },
-            &mut [false; 3],
-        );
+        let err = guide_step(&scene, &mut rows, &mut grads, &step(&guides, 1, 0.1), &mut [false; 3]);
         assert_eq!(err, Err(Error::BadParameter));
     }
 
@@ -645,15 +584,7 @@ mod tests {
             &Scene::<4>::new(),
             &mut rows,
             &mut grads,
-            &GuideStep {
-                guides: &EDMP_GUIDES,
-                t: 10,
-                rule: StepRule {
-                    step_limit: f32::INFINITY,
-                    cylinder: CylinderBox::Enclosing,
-                    frame: BoxFrame::Obstacle,
-                },
-            },
+            &step(&EDMP_GUIDES, 10, f32::INFINITY),
             &mut [],
         );
         assert_eq!(err, Err(Error::BadParameter));
@@ -663,15 +594,7 @@ mod tests {
             &Scene::<4>::new(),
             &mut twelve,
             &mut short,
-            &GuideStep {
-                guides: &EDMP_GUIDES,
-                t: 10,
-                rule: StepRule {
-                    step_limit: f32::INFINITY,
-                    cylinder: CylinderBox::Enclosing,
-                    frame: BoxFrame::Obstacle,
-                },
-            },
+            &step(&EDMP_GUIDES, 10, f32::INFINITY),
             &mut [],
         );
         assert_eq!(err, Err(Error::BadParameter));
@@ -690,15 +613,7 @@ mod tests {
             &scene,
             &mut free,
             &mut grads,
-            &GuideStep {
-                guides: &[guide],
-                t: 200,
-                rule: StepRule {
-                    step_limit: f32::INFINITY,
-                    cylinder: CylinderBox::Enclosing,
-                    frame: BoxFrame::Obstacle,
-                },
-            },
+            &step(&[guide], 200, f32::INFINITY),
             &mut [],
         )
         .unwrap();
@@ -712,40 +627,11 @@ mod tests {
         };
         assert!(moved(&free) > 0.02, "the raw step is long: {}", moved(&free));
         let mut limited = [line(a, b)];
-        guide_step(
-            &scene,
-            &mut limited,
-            &mut grads,
-            &GuideStep {
-                guides: &[guide],
-                t: 200,
-                rule: StepRule {
-                    step_limit: 0.02,
-                    cylinder: CylinderBox::Enclosing,
-                    frame: BoxFrame::Obstacle,
-                },
-            },
-            &mut [],
-        )
-        .unwrap();
+        guide_step(&scene, &mut limited, &mut grads, &step(&[guide], 200, 0.02), &mut []).unwrap();
         assert!(moved(&limited) <= 0.02 + 1e-6, "{}", moved(&limited));
         assert!(moved(&limited) > 0.0);
         for bad in [0.0, -1.0, f32::NAN] {
-            let err = guide_step(
-                &scene,
-                &mut limited,
-                &mut grads,
-                &GuideStep {
-                    guides: &[guide],
-                    t: 200,
-                    rule: StepRule {
-                        step_limit: bad,
-                        cylinder: CylinderBox::Enclosing,
-                        frame: BoxFrame::Obstacle,
-                    },
-                },
-                &mut [],
-            );
+            let err = guide_step(&scene, &mut limited, &mut grads, &step(&[guide], 200, bad), &mut []);
             assert_eq!(err, Err(Error::BadParameter));
         }
     }
@@ -795,22 +681,7 @@ mod tests {
             let mut grads = [[[0.0; 7]; H]];
             let g = Guide { smooth, ..guide };
             for _ in 0..20 {
-                guide_step(
-                    scene,
-                    &mut rows,
-                    &mut grads,
-                    &GuideStep {
-                        guides: &[g],
-                        t: 1,
-                        rule: StepRule {
-                            step_limit: 0.1,
-                            cylinder: CylinderBox::Enclosing,
-                            frame: BoxFrame::Obstacle,
-                        },
-                    },
-                    &mut [],
-                )
-                .unwrap();
+                guide_step(scene, &mut rows, &mut grads, &step(&[g], 1, 0.1), &mut []).unwrap();
             }
             rows[0]
         };

@@ -29,6 +29,17 @@ fn wall_scene() -> Scene<4> {
 const START: Joints<f32> = [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
 const GOAL: Joints<f32> = [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
 
+/// The problem from [`START`] to [`GOAL`] in `scene` with EDMP's guides and `config`.
+fn request<'a>(scene: &'a Scene<4>, config: &'a PlanConfig) -> Request<'a, 4> {
+    Request {
+        scene,
+        start: &START,
+        goal: &GOAL,
+        guides: &EDMP_GUIDES,
+        config,
+    }
+}
+
 fn config() -> PlanConfig {
     PlanConfig {
         sampler: Sampler::Strided { steps: 10 },
@@ -85,18 +96,7 @@ fn across_the_wall(global: GlobalConfig) -> PlanConfig {
 fn plan_wall_with(cfg: &PlanConfig) -> Result<Plan<12>, Error> {
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<12>::new());
-    plan(
-        &Request {
-            scene: &wall_scene(),
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: cfg,
-        },
-        &mut Rng::new(1),
-        &mut scratch,
-        &mut work,
-    )
+    plan(&request(&wall_scene(), cfg), &mut Rng::new(1), &mut scratch, &mut work)
 }
 
 #[test]
@@ -135,18 +135,7 @@ fn selection_stops_at_the_first_contact_unless_no_candidate_is_free() {
     });
     let cfg = config();
     // None free: every candidate's contacts are counted in full; ties go to the lower row.
-    let none = select(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &cfg,
-        },
-        [straight, straight],
-        &RowChecks::NONE,
-    )
-    .unwrap();
+    let none = select(&request(&scene, &cfg), [straight, straight], &RowChecks::NONE).unwrap();
     assert!(!none.is_free());
     assert!(none.verdicts.iter().all(|v| !v.free && v.colliding_states > 1));
     assert_eq!(none.best, 0);
@@ -155,18 +144,7 @@ fn selection_stops_at_the_first_contact_unless_no_candidate_is_free() {
     let mut work = Box::new(Workspace::<12>::new());
     let planned = plan_wall(&GOAL, &mut scratch, &mut work).unwrap();
     let free = planned.paths[planned.best];
-    let one = select(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &cfg,
-        },
-        [straight, free],
-        &RowChecks::NONE,
-    )
-    .unwrap();
+    let one = select(&request(&scene, &cfg), [straight, free], &RowChecks::NONE).unwrap();
     assert_eq!(one.best, 1);
     assert!(one.verdicts[1].free && one.verdicts[1].colliding_states == 0);
     assert!(!one.verdicts[0].free && one.verdicts[0].colliding_states == 1);
@@ -178,13 +156,7 @@ fn denoise_wall(cfg: &PlanConfig, seed: u64) -> [Path; 12] {
     let mut work = Box::new(Workspace::<12>::new());
     let mut paths = [[[0.0f32; JOINTS]; HORIZON]; 12];
     denoise(
-        &Request {
-            scene: &wall_scene(),
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: cfg,
-        },
+        &request(&wall_scene(), cfg),
         &mut Rng::new(seed),
         &mut scratch,
         &mut work,
@@ -343,13 +315,7 @@ fn refine_batch(
     let mut saved = grads;
     refine::<_, 12, 4>(
         &Serial,
-        &Request {
-            scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: cfg,
-        },
+        &request(scene, cfg),
         (&mut paths, &mut saved, &mut grads),
         steps,
         (&mut checks.free, &mut checks.touched),
@@ -407,36 +373,14 @@ fn where_the_judge_starts_its_walk_changes_no_verdict() {
         global: None,
         ..config()
     };
-    let plain = select(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &cfg,
-        },
-        mixed_batch(),
-        &RowChecks::NONE,
-    )
-    .unwrap();
+    let plain = select(&request(&scene, &cfg), mixed_batch(), &RowChecks::NONE).unwrap();
     for first in [0u16, 7, 24, 48, 49, 200] {
         let hinted = RowChecks {
             free: [false; 12],
             touched: [Some(first); 12],
             skipped: [false; 12],
         };
-        let judged = select(
-            &Request {
-                scene: &scene,
-                start: &START,
-                goal: &GOAL,
-                guides: &EDMP_GUIDES,
-                config: &cfg,
-            },
-            mixed_batch(),
-            &hinted,
-        )
-        .unwrap();
+        let judged = select(&request(&scene, &cfg), mixed_batch(), &hinted).unwrap();
         assert_eq!(judged.verdicts, plain.verdicts, "walks from segment {first}");
         assert_eq!(judged.best, plain.best);
     }
@@ -456,30 +400,8 @@ fn judging_the_winner_only_picks_what_judging_every_candidate_picks() {
         ..every
     };
     // Rows 0-5 collide, 6-11 are free: the lowest swept volume among the free ones wins.
-    let all = select(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &every,
-        },
-        mixed_batch(),
-        &RowChecks::NONE,
-    )
-    .unwrap();
-    let lazy = select(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &winner,
-        },
-        mixed_batch(),
-        &RowChecks::NONE,
-    )
-    .unwrap();
+    let all = select(&request(&scene, &every), mixed_batch(), &RowChecks::NONE).unwrap();
+    let lazy = select(&request(&scene, &winner), mixed_batch(), &RowChecks::NONE).unwrap();
     assert!(all.verdicts.iter().all(|v| v.checked));
     assert_eq!(
         (lazy.best, lazy.verdicts[lazy.best]),
@@ -503,30 +425,8 @@ fn judging_the_winner_only_picks_what_judging_every_candidate_picks() {
     );
     // Nothing free: every candidate is judged, as under `Judging::Every`.
     let colliding: [Path; 12] = core::array::from_fn(|_| mixed_batch()[0]);
-    let a = select(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &every,
-        },
-        colliding,
-        &RowChecks::NONE,
-    )
-    .unwrap();
-    let b = select(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &winner,
-        },
-        colliding,
-        &RowChecks::NONE,
-    )
-    .unwrap();
+    let a = select(&request(&scene, &every), colliding, &RowChecks::NONE).unwrap();
+    let b = select(&request(&scene, &winner), colliding, &RowChecks::NONE).unwrap();
     assert_eq!(a, b);
     // The refinement's stop checks rows in order up to the first free one; the paths are
     // the same as when it checks them all.
@@ -723,20 +623,7 @@ fn each_wave_is_the_plan_of_its_guides_alone_and_rows_keep_the_callers_order() {
     let mut work = Box::new(Workspace::<12>::new());
     let mut waved = [[[0.0f32; JOINTS]; HORIZON]; 12];
     let mut rng = Rng::new(9);
-    denoise(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &cfg,
-        },
-        &mut rng,
-        &mut scratch,
-        &mut work,
-        &mut waved,
-    )
-    .unwrap();
+    denoise(&request(&scene, &cfg), &mut rng, &mut scratch, &mut work, &mut waved).unwrap();
     assert!(work.checks.skipped.iter().all(|&s| !s));
     let mut alone = Rng::new(9);
     let mut small = Box::new(Workspace::<4>::new());
@@ -766,18 +653,7 @@ fn each_wave_is_the_plan_of_its_guides_alone_and_rows_keep_the_callers_order() {
     // Nothing free: the judge judges all 12, none is free.
     let mut plan = Plan::<12>::empty();
     plan.paths = waved;
-    judge(
-        &Request {
-            scene: &scene,
-            start: &START,
-            goal: &GOAL,
-            guides: &EDMP_GUIDES,
-            config: &cfg,
-        },
-        &mut plan,
-        &work.checks,
-    )
-    .unwrap();
+    judge(&request(&scene, &cfg), &mut plan, &work.checks).unwrap();
     assert!(plan.verdicts.iter().all(|v| v.made && v.checked && !v.free));
 }
 
@@ -789,13 +665,7 @@ fn a_free_wave_ends_the_plan_and_the_rows_not_made_are_never_picked() {
     let mut work = Box::new(Workspace::<12>::new());
     let mut run = |seed: u64| {
         plan(
-            &Request {
-                scene: &wall_scene(),
-                start: &START,
-                goal: &GOAL,
-                guides: &EDMP_GUIDES,
-                config: &cfg,
-            },
+            &request(&wall_scene(), &cfg),
             &mut Rng::new(seed),
             &mut *scratch,
             &mut *work,
@@ -835,13 +705,7 @@ fn a_free_wave_ends_the_plan_and_the_rows_not_made_are_never_picked() {
     let mut waved = |waves: u8| {
         let cfg = PlanConfig { waves, ..config() };
         plan(
-            &Request {
-                scene: &wall_scene(),
-                start: &START,
-                goal: &GOAL,
-                guides: &EDMP_GUIDES,
-                config: &cfg,
-            },
+            &request(&wall_scene(), &cfg),
             &mut Rng::new(2),
             &mut *scratch,
             &mut *work,
