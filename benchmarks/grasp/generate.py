@@ -1,5 +1,5 @@
 """Writes the grasp table: a can on a table, the goal a horizontal grasp around it with the
-fingers open to 0.04 m (`"gripper": {"finger": 0.04}`, shared/spec/formats.md).
+fingers open to 0.04 m (`"gripper": {"finger": 0.04}`, docs/formats.md).
 
 Each problem: a table top (upper face at height `top`), a can (a cylinder of radius r and
 height h standing on it) and, in some, a second can beside it; the start is the Panda's ready

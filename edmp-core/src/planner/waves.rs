@@ -8,8 +8,7 @@ use crate::guidance::guides::Guide;
 use crate::path::Path;
 use crate::planner::judge::certify;
 use crate::planner::request::Request;
-use crate::planner::workspace::{RowChecks, Workspace};
-use crate::planner::workspace::{WaveChecks, WaveRows};
+use crate::planner::workspace::{RowChecks, WaveChecks, WaveRows, Workspace};
 
 /// Runs `wave` on the batch in [`PlanConfig::waves`] waves, one after another: wave `w` gives
 /// guides `w`, `w + waves`, `w + 2·waves`, … (so that each wave mixes the caller's order) their
