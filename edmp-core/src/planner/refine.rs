@@ -121,8 +121,10 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
         rule: step_rule(config),
     };
     for s in 0..steps {
+        // `every` is not zero (checked above); `checked_rem` says so to the compiler, which
+        // keeps a panic path out of the firmware.
         if let Some(stop) = config.refine_stop
-            && s % stop.every == 0
+            && s.checked_rem(stop.every) == Some(0)
         {
             let free = certify::<E, B, N>(exec, &req, paths, certified, touched, stop.free)?;
             if free >= usize::from(stop.free) || (stop.stall > 0 && stalled >= u16::from(stop.stall)) {
