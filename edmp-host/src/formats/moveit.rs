@@ -1215,3 +1215,74 @@ pub fn import_validated(scene_yaml: &str, request_yaml: Option<&str>) -> Result<
         parse_problem(&doc.to_string()).map_err(|e| format!("the imported edmp-scene/1 is not valid: {e}"))?;
     Ok((doc, problem))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn yaml(text: &str) -> Value {
+        load(text).unwrap()
+    }
+
+    #[test]
+    fn a_mesh_becomes_the_scene_formats_mesh_obstacle() {
+        // shape_msgs/Mesh as ROS writes it, placed 1 m up and yawed 90°.
+        let v = yaml(
+            "triangles:\n- vertex_indices: [0, 1, 2]\n- vertex_indices: [0, 2, 3]\nvertices:\n\
+             - {x: 0.0, y: 0.0, z: 0.0}\n- {x: 0.1, y: 0.0, z: 0.0}\n- {x: 0.1, y: 0.1, z: 0.0}\n- {x: 0, y: 0.1, z: 0}\n",
+        );
+        let placed = Isometry3::from_parts(
+            Translation3::new(0.0, 0.0, 1.0),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), core::f64::consts::FRAC_PI_2),
+        );
+        let h = core::f64::consts::FRAC_1_SQRT_2;
+        let want = json!({
+            "type": "mesh",
+            "vertices": [[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.1, 0.0], [0.0, 0.1, 0.0]],
+            "triangles": [[0, 1, 2], [0, 2, 3]],
+            "center": [0.0, 0.0, 1.0],
+            "quaternion": [round(h), 0.0, 0.0, round(h)],
+            "scale": 1,
+        });
+        assert_eq!(mesh(&v, "m", &placed).unwrap(), want);
+        // robowflex's compact form: the same mesh.
+        let compact = yaml("triangles: [[0, 1, 2], [0, 2, 3]]\nvertices: [[0, 0, 0], [0.1, 0, 0], [0.1, 0.1, 0], [0, 0.1, 0]]\n");
+        assert_eq!(mesh(&compact, "m", &placed).unwrap(), want);
+    }
+
+    #[test]
+    fn a_bad_mesh_names_its_path() {
+        let id = Isometry3::identity();
+        let cases = [
+            ("triangles: [[0, 1, 3]]\nvertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]", "m.triangles[0][2]", "3 is not a vertex index (0..3)"),
+            ("triangles: [{vertex_indices: [0, 1]}]\nvertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]", "m.triangles[0].vertex_indices", "expected 3 vertex indices, found 2"),
+            ("triangles: []\nvertices: [[0, 0, 0]]", "m.triangles", "missing: a mesh has triangles"),
+            ("vertices: []", "m.vertices", "missing: a mesh has vertices"),
+            ("resource: package://x/bunny.dae\ndimensions: [1, 1, 1]", "m.resource", "a mesh file"),
+            ("triangles: [[0, 1, 2]]\nvertices: [[0, 0], [1, 0, 0], [0, 1, 0]]", "m.vertices[0]", "expected 3 numbers, found 2"),
+        ];
+        for (text, path, message) in cases {
+            let e = mesh(&yaml(text), "m", &id).unwrap_err();
+            assert_eq!(e.path, path, "{text}");
+            assert!(e.message.starts_with(message), "{text}: {}", e.message);
+        }
+    }
+
+    #[test]
+    fn the_virtual_joint_places_the_base() {
+        let none = base_placement(&yaml("joint_names: []\ntransforms: []"), "s").unwrap();
+        assert!(none.is_none());
+        // Near the identity reads as the identity exactly.
+        let near = yaml("joint_names: [virtual_joint]\ntransforms: [{translation: [1e-12, 0, 0], rotation: [0, 0, 0, 1]}]");
+        assert_eq!(base_placement(&near, "s").unwrap(), Some(Isometry3::identity()));
+        let moved = yaml("joint_names: [base]\ntransforms: [{translation: {x: 1, y: 2, z: 0}, rotation: {x: 0, y: 0, z: 0, w: 1}}]");
+        let p = base_placement(&moved, "s").unwrap().unwrap();
+        assert_eq!(p.translation.vector, Vector3::new(1.0, 2.0, 0.0));
+        let two = yaml("joint_names: [a, b]\ntransforms: [{}, {}]");
+        assert_eq!(base_placement(&two, "s").unwrap_err().path, "s.joint_names[1]");
+        let short = yaml("joint_names: [a]\ntransforms: []");
+        assert_eq!(base_placement(&short, "s").unwrap_err().path, "s.transforms");
+        let frame = yaml("header: {frame_id: panda_link0}\njoint_names: [a]\ntransforms: [{}]");
+        assert_eq!(base_placement(&frame, "s").unwrap_err().path, "s.header.frame_id");
+    }
+}
