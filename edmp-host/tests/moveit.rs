@@ -276,11 +276,19 @@ fn scenes_as_moveit_and_motionbenchmaker_export_them_are_the_explicit_frame_scen
     let explicit = file("table_box.scene.yaml");
     for name in ["exported.scene.yaml", "robowflex.scene.yaml"] {
         let scene = file(name);
-        for request in [None, Some(file("joint_goal.request.yaml")), Some(file("pose_goal.request.yaml"))] {
+        for request in [
+            None,
+            Some(file("joint_goal.request.yaml")),
+            Some(file("pose_goal.request.yaml")),
+        ] {
             let (got, _) = import_validated(&scene, request.as_deref()).unwrap_or_else(|e| panic!("{name}: {e}"));
             let (want, _) = import_validated(&explicit, request.as_deref()).unwrap();
             assert_same_problem(&got, &want, name);
-            assert_eq!(got["meta"]["object_ids"], json!(["table", "wall", "can", "ball"]), "{name}");
+            assert_eq!(
+                got["meta"]["object_ids"],
+                json!(["table", "wall", "can", "ball"]),
+                "{name}"
+            );
         }
     }
 }
@@ -302,7 +310,10 @@ fn an_object_may_name_a_frame_of_fixed_frame_transforms() {
     assert!(scene.contains("table_frame}"), "{scene}");
     let (got, _) = import_validated(&scene, None).unwrap();
     let (want, _) = import_validated(&file("table_box.scene.yaml"), None).unwrap();
-    let (a, b) = (got["obstacles"].as_array().unwrap(), want["obstacles"].as_array().unwrap());
+    let (a, b) = (
+        got["obstacles"].as_array().unwrap(),
+        want["obstacles"].as_array().unwrap(),
+    );
     assert_eq!(a.len(), b.len());
     for (i, (x, y)) in a.iter().zip(b).enumerate() {
         assert_same_primitive(x, y, 1e-12, &format!("obstacles[{i}]"));
@@ -359,7 +370,10 @@ fn a_placed_virtual_joint_puts_the_world_in_the_base_frame() {
         let request = request.replace("{frame_id: panda_link0}", "{frame_id: world}");
         // The virtual joint in the scene's robot state, or in the request's start state (which,
         // as MoveIt merges it, wins over the scene's).
-        let in_scene = (scene.replace("robot_state:\n", &format!("robot_state:\n{joint}")), request.clone());
+        let in_scene = (
+            scene.replace("robot_state:\n", &format!("robot_state:\n{joint}")),
+            request.clone(),
+        );
         let in_request = (
             scene.replace("robot_state:\n", "robot_state:\n  multi_dof_joint_state: {joint_names: [virtual_joint], transforms: [{translation: [5, 5, 5], rotation: [0, 0, 0, 1]}]}\n"),
             request.replace("start_state:\n", &format!("start_state:\n{joint}")),
@@ -381,8 +395,14 @@ fn a_placed_virtual_joint_puts_the_world_in_the_base_frame() {
             }
             if let Some(p) = original["goal"].get("pose") {
                 let q = &back["goal"]["pose"];
-                assert!(close(&floats(&p["position"]), &floats(&q["position"]), 1e-6), "{name}: {p} vs {q}");
-                assert!(same_rotation(&floats(&p["quaternion"]), &floats(&q["quaternion"]), 1e-6), "{name}");
+                assert!(
+                    close(&floats(&p["position"]), &floats(&q["position"]), 1e-6),
+                    "{name}: {p} vs {q}"
+                );
+                assert!(
+                    same_rotation(&floats(&p["quaternion"]), &floats(&q["quaternion"]), 1e-6),
+                    "{name}"
+                );
             }
         }
     }

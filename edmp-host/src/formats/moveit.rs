@@ -749,7 +749,9 @@ fn base_placement(v: &Value, path: &str) -> R<Option<Isometry3<f64>>> {
     if !(parent.is_empty() || parent == PLANNING_FRAME) {
         return Err(at(
             &join(path, "header.frame_id"),
-            format!("frame {parent:?} is not supported (the virtual joint's parent is the planning frame: world, or empty)"),
+            format!(
+                "frame {parent:?} is not supported (the virtual joint's parent is the planning frame: world, or empty)"
+            ),
         ));
     }
     let t0 = format!("{tp}[0]");
@@ -928,8 +930,7 @@ fn goal(v: &Value, path: &str, frames: &Frames) -> R<(Value, Fingers)> {
         [p] => (pframe * pose(Some(p), &format!("{posep}[0]"))?).translation.vector,
         _ => return Err(at(&posep, "more than one region: the target must be one point")),
     };
-    let rotation =
-        oframe.rotation * orientation(om.and_then(|m| m.get("orientation")), &join(&op, "orientation"))?;
+    let rotation = oframe.rotation * orientation(om.and_then(|m| m.get("orientation")), &join(&op, "orientation"))?;
     // The constrained point is `link · point_offset`; place the link so it lands on the target.
     let link_pose = Isometry3::from_parts(Translation3::from(target - rotation * point_offset), rotation);
     let (position, quaternion) = center_and_quaternion(&(link_pose * offset));
@@ -1246,7 +1247,8 @@ mod tests {
         });
         assert_eq!(mesh(&v, "m", &placed).unwrap(), want);
         // robowflex's compact form: the same mesh.
-        let compact = yaml("triangles: [[0, 1, 2], [0, 2, 3]]\nvertices: [[0, 0, 0], [0.1, 0, 0], [0.1, 0.1, 0], [0, 0.1, 0]]\n");
+        let compact =
+            yaml("triangles: [[0, 1, 2], [0, 2, 3]]\nvertices: [[0, 0, 0], [0.1, 0, 0], [0.1, 0.1, 0], [0, 0.1, 0]]\n");
         assert_eq!(mesh(&compact, "m", &placed).unwrap(), want);
     }
 
@@ -1254,12 +1256,32 @@ mod tests {
     fn a_bad_mesh_names_its_path() {
         let id = Isometry3::identity();
         let cases = [
-            ("triangles: [[0, 1, 3]]\nvertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]", "m.triangles[0][2]", "3 is not a vertex index (0..3)"),
-            ("triangles: [{vertex_indices: [0, 1]}]\nvertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]", "m.triangles[0].vertex_indices", "expected 3 vertex indices, found 2"),
-            ("triangles: []\nvertices: [[0, 0, 0]]", "m.triangles", "missing: a mesh has triangles"),
+            (
+                "triangles: [[0, 1, 3]]\nvertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]",
+                "m.triangles[0][2]",
+                "3 is not a vertex index (0..3)",
+            ),
+            (
+                "triangles: [{vertex_indices: [0, 1]}]\nvertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]",
+                "m.triangles[0].vertex_indices",
+                "expected 3 vertex indices, found 2",
+            ),
+            (
+                "triangles: []\nvertices: [[0, 0, 0]]",
+                "m.triangles",
+                "missing: a mesh has triangles",
+            ),
             ("vertices: []", "m.vertices", "missing: a mesh has vertices"),
-            ("resource: package://x/bunny.dae\ndimensions: [1, 1, 1]", "m.resource", "a mesh file"),
-            ("triangles: [[0, 1, 2]]\nvertices: [[0, 0], [1, 0, 0], [0, 1, 0]]", "m.vertices[0]", "expected 3 numbers, found 2"),
+            (
+                "resource: package://x/bunny.dae\ndimensions: [1, 1, 1]",
+                "m.resource",
+                "a mesh file",
+            ),
+            (
+                "triangles: [[0, 1, 2]]\nvertices: [[0, 0], [1, 0, 0], [0, 1, 0]]",
+                "m.vertices[0]",
+                "expected 3 numbers, found 2",
+            ),
         ];
         for (text, path, message) in cases {
             let e = mesh(&yaml(text), "m", &id).unwrap_err();
@@ -1273,9 +1295,12 @@ mod tests {
         let none = base_placement(&yaml("joint_names: []\ntransforms: []"), "s").unwrap();
         assert!(none.is_none());
         // Near the identity reads as the identity exactly.
-        let near = yaml("joint_names: [virtual_joint]\ntransforms: [{translation: [1e-12, 0, 0], rotation: [0, 0, 0, 1]}]");
+        let near =
+            yaml("joint_names: [virtual_joint]\ntransforms: [{translation: [1e-12, 0, 0], rotation: [0, 0, 0, 1]}]");
         assert_eq!(base_placement(&near, "s").unwrap(), Some(Isometry3::identity()));
-        let moved = yaml("joint_names: [base]\ntransforms: [{translation: {x: 1, y: 2, z: 0}, rotation: {x: 0, y: 0, z: 0, w: 1}}]");
+        let moved = yaml(
+            "joint_names: [base]\ntransforms: [{translation: {x: 1, y: 2, z: 0}, rotation: {x: 0, y: 0, z: 0, w: 1}}]",
+        );
         let p = base_placement(&moved, "s").unwrap().unwrap();
         assert_eq!(p.translation.vector, Vector3::new(1.0, 2.0, 0.0));
         let two = yaml("joint_names: [a, b]\ntransforms: [{}, {}]");
