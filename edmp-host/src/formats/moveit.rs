@@ -1,21 +1,44 @@
-//! MoveIt's planning scenes as `edmp-scene/1`: a `moveit_msgs/PlanningScene` as YAML (e.g.
-//! from `rostopic echo` / `ros2 topic echo`) and optionally a `moveit_msgs/MotionPlanRequest`
-//! (YAML) become one document, validated through the host's JSON reader.
+//! MoveIt's planning scenes as `edmp-scene/1`: a `moveit_msgs/PlanningScene` as YAML (from
+//! `rostopic echo` / `ros2 topic echo`, MoveIt's scene export, or MotionBenchMaker's robowflex
+//! files) and optionally a `moveit_msgs/MotionPlanRequest` (YAML) become one document,
+//! validated through the host's JSON reader.
 //!
-//! What is read: `world.collision_objects[]` (BOX, SPHERE, CYLINDER primitives; the world pose
-//! of each is the object's `pose` times the primitive's pose), one object attached to
-//! `panda_hand` with one primitive (the held object), the start from the request's
+//! What is read: `world.collision_objects[]` (BOX, SPHERE, CYLINDER primitives; the pose of each
+//! is its frame's, times the object's `pose`, times the primitive's pose), one object attached
+//! to `panda_hand` with one primitive (the held object), the start from the request's
 //! `start_state.joint_state` (else the scene's `robot_state.joint_state`), and the goal from
 //! `goal_constraints[0]`: joint constraints, or one position and one orientation constraint on
 //! `panda_link8`, `panda_hand` or `panda_grasptarget` (converted to the TCP). ROS quaternions
-//! are `[x, y, z, w]`; ours are `[w, x, y, z]`. Frames: `panda_link0` (our world) or `world`
-//! (the Panda MoveIt configuration's fixed virtual joint, identity).
+//! are `{x, y, z, w}`; ours are `[w, x, y, z]`. Points and quaternions may also be flow
+//! sequences (`[x, y, z]`, `[x, y, z, w]`) and primitive types names (`box`, `sphere`,
+//! `cylinder`), as robowflex writes them; an operation is ADD as `0`, `"\x00"`, `b'\x00'`,
+//! `add`, or absent.
 //!
-//! Everything that would change the problem and cannot be expressed (meshes, planes, cones,
-//! other frames, other links, octomaps, path constraints, padding, a second goal) is an error
-//! naming its YAML path; fields that do not change the geometry or the ends (names, stamps,
-//! colours, planner settings, the allowed collision matrix, which only ever permits contacts)
-//! are ignored. Unknown fields are errors, as in `edmp-scene/1`.
+//! Frames. Our world is `panda_link0`, the Panda's base. MoveIt's planning frame is `world`;
+//! an absent header or an empty `frame_id` names it. Where it is relative to the base:
+//! - `multi_dof_joint_state` (the scene's robot state, or the request's start state, which wins
+//!   as MoveIt merges it): at most one joint, of any name (MoveIt's Panda: `virtual_joint`),
+//!   its parent the planning frame; its transform places `panda_link0` in `world`, and everything
+//!   given in `world` is brought into the base frame by its inverse. Within 1e-9 of the
+//!   identity it is the identity. Its twist and wrench, and joint velocities and efforts, are
+//!   ignored: a plan is positions. A second multi-DOF joint is an error.
+//! - no such joint: `world` is `panda_link0`.
+//! - `fixed_frame_transforms` (`geometry_msgs/TransformStamped`, parent the header's frame, empty
+//!   the planning frame): each child is a frame that objects and goal constraints may name; one
+//!   the importer already places (`world`, `panda_link0`) must agree with it to 1e-6 (an
+//!   identity `world` → `panda_link0` does, with no or an identity virtual joint); a robot link
+//!   other than the base is an error (the joint state places it).
+//!
+//! An attached object's frame is `panda_hand`, or empty (its link's, as MoveIt reads it).
+//!
+//! Everything that would change the problem and cannot be expressed is an error naming its YAML
+//! path: planes, cones, meshes (read and checked by `mesh`, then refused until the scene
+//! reader takes mesh obstacles; mesh files by `resource` are refused), octomap data, unknown
+//! frames and links, padding ≠ 0 or scale ≠ 1, operations other than ADD, path constraints, a
+//! second goal. Fields that do not change the geometry or the ends are read and ignored: names,
+//! stamps, `is_diff`, `robot_model_name` (`panda` or empty), colours, subframes, object types,
+//! planner settings, and the allowed collision matrix (it only ever permits contacts; the
+//! checker checks every pair the spec names). Unknown fields are errors, as in `edmp-scene/1`.
 
 use crate::formats::json::{Problem, parse_problem};
 use core::fmt;
