@@ -291,6 +291,10 @@ fn scenes_as_moveit_and_motionbenchmaker_export_them_are_the_explicit_frame_scen
             );
         }
     }
+    // A request as MotionBenchMaker stores it: the pose goal request's problem.
+    let (got, _) = import_validated(&file("robowflex.scene.yaml"), Some(&file("robowflex.request.yaml"))).unwrap();
+    let (want, _) = import_validated(&explicit, Some(&file("pose_goal.request.yaml"))).unwrap();
+    assert_same_problem(&got, &want, "robowflex.request.yaml");
 }
 
 #[test]

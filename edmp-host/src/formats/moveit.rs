@@ -240,7 +240,7 @@ fn string<'a>(map: Option<&'a Map<String, Value>>, path: &str, key: &str) -> R<&
     }
 }
 
-/// `n` numbers written as a flow sequence (`[x, y, z]`, as MotionBenchMaker's robowflex writes
+/// `N` numbers written as a flow sequence (`[x, y, z]`, as MotionBenchMaker's robowflex writes
 /// points and quaternions).
 fn numbers<const N: usize>(items: &[Value], path: &str) -> R<[f64; N]> {
     if items.len() != N {
@@ -366,7 +366,7 @@ impl Frames {
             at(
                 path,
                 format!(
-                    "frame {id:?} is not supported (the planning frame \"\" or world, or one of: {})",
+                    "frame {id:?} is not supported (known: {}; empty is world, the planning frame)",
                     names.join(", ")
                 ),
             )
