@@ -416,7 +416,7 @@ fn a_placed_virtual_joint_puts_the_world_in_the_base_frame() {
 fn exported_scenes_refuse_what_they_cannot_express_by_yaml_path() {
     let exported = file("exported.scene.yaml");
     let compact = file("robowflex.scene.yaml");
-    let cases: Vec<(String, &str)> = vec![
+    let mut cases: Vec<(String, &str)> = vec![
         (
             compact.replace(
                 "    joint_names: [virtual_joint]\n    transforms: [{translation: [0, 0, 0], rotation: [0, 0, 0, 1]}]",
@@ -502,6 +502,22 @@ fn exported_scenes_refuse_what_they_cannot_express_by_yaml_path() {
             "scene: world.collision_objects[3].operation: operation \"remove\" is not supported",
         ),
     ];
+    let held = |header: &str| {
+        exported.replace(
+            "  attached_collision_objects: []",
+            &format!(
+                "  attached_collision_objects:\n  - link_name: panda_hand\n    object:\n      {header}id: tool\n      \
+                 primitives: [{{type: 2, dimensions: [0.02]}}]\n      primitive_poses: [{{position: {{x: 0, y: 0, z: 0.1}}}}]"
+            ),
+        )
+    };
+    // An empty frame is the link's, as MoveIt reads it; no header is ambiguous.
+    let (doc, _) = import_validated(&held("header: {frame_id: ''}\n      "), None).unwrap();
+    assert_eq!(doc["held_object"]["center"], json!([0.0, 0.0, 0.1]));
+    cases.push((
+        held(""),
+        "scene: robot_state.attached_collision_objects[0].object: no header",
+    ));
     for (scene, want) in cases {
         assert_ne!(scene, exported);
         assert_ne!(scene, compact, "{want}: the replacement did not apply");

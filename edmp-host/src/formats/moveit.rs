@@ -29,7 +29,8 @@
 //!   identity `world` → `panda_link0` does, with no or an identity virtual joint); a robot link
 //!   other than the base is an error (the joint state places it).
 //!
-//! An attached object's frame is `panda_hand`, or empty (its link's, as MoveIt reads it).
+//! An attached object's frame is `panda_hand`, or empty (its link's, as MoveIt reads it); an
+//! attached object without a header is refused (robowflex would read it as `world`).
 //!
 //! Everything that would change the problem and cannot be expressed is an error naming its YAML
 //! path: planes, cones, meshes (read and checked by `mesh`, then refused until the scene
@@ -580,6 +581,14 @@ fn collision_object(v: &Value, path: &str, frames: ObjectFrames<'_>) -> R<(Strin
     let fid = frame_id(map, path)?;
     let frame = match frames {
         ObjectFrames::World(frames) => frames.pose(&fid, &join(path, "header.frame_id"))?,
+        // No header at all: ROS reads an empty frame (for an attached object, its link's),
+        // robowflex `world`. Not guessed.
+        ObjectFrames::Hand if map.is_none_or(|m| !m.contains_key("header")) => {
+            return Err(at(
+                path,
+                "no header: an attached object's frame is ambiguous without one (ROS reads its link's, MotionBenchMaker's robowflex world); give header.frame_id panda_hand",
+            ));
+        }
         // MoveIt reads an attached object's empty frame as its link's.
         ObjectFrames::Hand if fid.is_empty() || fid == FRAME_NAMES[HAND_FRAME] => Isometry3::identity(),
         ObjectFrames::Hand => {
