@@ -9,6 +9,7 @@ use edmp_core::robot::kinematics::forward;
 use edmp_host::formats::json::{Goal, joint_goal, parse_problem};
 use edmp_host::formats::moveit::{Source, import, import_validated};
 use edmp_host::planning::{chosen_guides, plan_problem};
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use serde_json::{Value, json};
 use std::process::Command;
 
@@ -257,6 +258,270 @@ fn unsupported_or_bad_entries_name_their_yaml_path() {
     ];
     for (scene, request, want) in cases {
         let got = error(&scene, request.as_deref(), want);
+        assert!(got.starts_with(want), "expected {want:?}, got {got:?}");
+    }
+}
+
+/// The obstacles, start and goal of two imports are the same document parts, exactly.
+fn assert_same_problem(got: &Value, want: &Value, what: &str) {
+    for key in ["obstacles", "start", "goal", "gripper", "held_object"] {
+        assert_eq!(got.get(key), want.get(key), "{what}: {key}");
+    }
+}
+
+#[test]
+fn scenes_as_moveit_and_motionbenchmaker_export_them_are_the_explicit_frame_scene() {
+    // Empty or absent frames, the identity virtual joint, fixed transforms, a collision matrix,
+    // neutral padding and scale, an empty octomap, byte operations; and robowflex's compact forms.
+    let explicit = file("table_box.scene.yaml");
+    for name in ["exported.scene.yaml", "robowflex.scene.yaml"] {
+        let scene = file(name);
+        for request in [
+            None,
+            Some(file("joint_goal.request.yaml")),
+            Some(file("pose_goal.request.yaml")),
+        ] {
+            let (got, _) = import_validated(&scene, request.as_deref()).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let (want, _) = import_validated(&explicit, request.as_deref()).unwrap();
+            assert_same_problem(&got, &want, name);
+            assert_eq!(
+                got["meta"]["object_ids"],
+                json!(["table", "wall", "can", "ball"]),
+                "{name}"
+            );
+        }
+    }
+    // A request as MotionBenchMaker stores it: the pose goal request's problem.
+    let (got, _) = import_validated(&file("robowflex.scene.yaml"), Some(&file("robowflex.request.yaml"))).unwrap();
+    let (want, _) = import_validated(&explicit, Some(&file("pose_goal.request.yaml"))).unwrap();
+    assert_same_problem(&got, &want, "robowflex.request.yaml");
+}
+
+#[test]
+fn an_object_may_name_a_frame_of_fixed_frame_transforms() {
+    // The table's placement moved from its pose to a fixed frame it names.
+    let scene = file("robowflex.scene.yaml")
+        .replace(
+            "allowed_collision_matrix:",
+            "  - header: {frame_id: panda_link0}\n    child_frame_id: table_frame\n    transform:\n      \
+             translation: [0.5, 0, 0]\n      rotation: [0, 0, 0.7071067811865476, 0.7071067811865476]\n\
+             allowed_collision_matrix:",
+        )
+        .replace(
+            "    - id: table\n      pose:\n        position: [0.5, 0, 0]\n        orientation: [0, 0, 0.7071067811865476, 0.7071067811865476]\n",
+            "    - id: table\n      header: {frame_id: table_frame}\n",
+        );
+    assert!(scene.contains("table_frame}"), "{scene}");
+    let (got, _) = import_validated(&scene, None).unwrap();
+    let (want, _) = import_validated(&file("table_box.scene.yaml"), None).unwrap();
+    let (a, b) = (
+        got["obstacles"].as_array().unwrap(),
+        want["obstacles"].as_array().unwrap(),
+    );
+    assert_eq!(a.len(), b.len());
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        assert_same_primitive(x, y, 1e-12, &format!("obstacles[{i}]"));
+    }
+}
+
+/// `doc` with every obstacle and the pose goal placed by `base` (as a world whose
+/// `panda_link0` is at `base` sees them).
+fn seen_from_world(doc: &Value, base: &Isometry3<f64>) -> Value {
+    let place = |center: &[f64], wxyz: &[f64]| {
+        let q = UnitQuaternion::from_quaternion(Quaternion::new(wxyz[0], wxyz[1], wxyz[2], wxyz[3]));
+        let p = base * Isometry3::from_parts(Translation3::new(center[0], center[1], center[2]), q);
+        let q = p.rotation.quaternion();
+        (
+            json!([p.translation.x, p.translation.y, p.translation.z]),
+            json!([q.w, q.i, q.j, q.k]),
+        )
+    };
+    let mut out = doc.clone();
+    for o in out["obstacles"].as_array_mut().unwrap() {
+        let wxyz = o.get("quaternion").map_or(vec![1.0, 0.0, 0.0, 0.0], floats);
+        let (c, q) = place(&floats(&o["center"]), &wxyz);
+        o["center"] = c;
+        if o["type"] != "sphere" {
+            o["quaternion"] = q;
+        }
+    }
+    if let Some(pose) = out["goal"].get_mut("pose") {
+        let (c, q) = place(&floats(&pose["position"]), &floats(&pose["quaternion"]));
+        pose["position"] = c;
+        pose["quaternion"] = q;
+    }
+    out
+}
+
+#[test]
+fn a_placed_virtual_joint_puts_the_world_in_the_base_frame() {
+    // panda_link0 1 m forward, 0.5 m left, 0.2 m up and yawed 90° in `world`: obstacles and goals
+    // written in `world` (or an empty frame) come back in panda_link0, where the examples have them.
+    let h = core::f64::consts::FRAC_1_SQRT_2;
+    let base = Isometry3::from_parts(
+        Translation3::new(1.0, 0.5, 0.2),
+        UnitQuaternion::from_quaternion(Quaternion::new(h, 0.0, 0.0, h)),
+    );
+    let joint = format!(
+        "  multi_dof_joint_state:\n    header: {{frame_id: world}}\n    joint_names: [virtual_joint]\n    \
+         transforms: [{{translation: {{x: 1.0, y: 0.5, z: 0.2}}, rotation: {{x: 0, y: 0, z: {h}, w: {h}}}}}]\n    \
+         twist: [{{linear: {{x: 0.1, y: 0, z: 0}}, angular: {{x: 0, y: 0, z: 0}}}}]\n    wrench: []\n"
+    );
+    for name in ["wall.json", "tabletop-pose-held.json"] {
+        let original = example(name);
+        let (scene, request) = to_moveit(&seen_from_world(&original, &base));
+        let scene = scene.replace("{frame_id: panda_link0}", "{frame_id: ''}");
+        let request = request.replace("{frame_id: panda_link0}", "{frame_id: world}");
+        // The virtual joint in the scene's robot state, or in the request's start state (which,
+        // as MoveIt merges it, wins over the scene's).
+        let in_scene = (
+            scene.replace("robot_state:\n", &format!("robot_state:\n{joint}")),
+            request.clone(),
+        );
+        let in_request = (
+            scene.replace("robot_state:\n", "robot_state:\n  multi_dof_joint_state: {joint_names: [virtual_joint], transforms: [{translation: [5, 5, 5], rotation: [0, 0, 0, 1]}]}\n"),
+            request.replace("start_state:\n", &format!("start_state:\n{joint}")),
+        );
+        for (scene, request) in [in_scene, in_request] {
+            let (back, _) =
+                import_validated(&scene, Some(&request)).unwrap_or_else(|e| panic!("{name}: {e}\n{scene}\n{request}"));
+            let (a, b) = (
+                original["obstacles"].as_array().unwrap(),
+                back["obstacles"].as_array().unwrap(),
+            );
+            assert_eq!(a.len(), b.len(), "{name}");
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                // The examples' quaternions are f32s, normalised on the way: 1e-6, not 1e-12.
+                assert_same_primitive(x, y, 1e-6, &format!("{name}: obstacles[{i}]"));
+            }
+            if let Some(held) = original.get("held_object") {
+                assert_same_primitive(held, &back["held_object"], 1e-12, name);
+            }
+            if let Some(p) = original["goal"].get("pose") {
+                let q = &back["goal"]["pose"];
+                assert!(
+                    close(&floats(&p["position"]), &floats(&q["position"]), 1e-6),
+                    "{name}: {p} vs {q}"
+                );
+                assert!(
+                    same_rotation(&floats(&p["quaternion"]), &floats(&q["quaternion"]), 1e-6),
+                    "{name}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn exported_scenes_refuse_what_they_cannot_express_by_yaml_path() {
+    let exported = file("exported.scene.yaml");
+    let compact = file("robowflex.scene.yaml");
+    let mut cases: Vec<(String, &str)> = vec![
+        (
+            compact.replace(
+                "    joint_names: [virtual_joint]\n    transforms: [{translation: [0, 0, 0], rotation: [0, 0, 0, 1]}]",
+                "    joint_names: [virtual_joint, mobile_base]\n    transforms: [{translation: [0, 0, 0], rotation: [0, 0, 0, 1]}, {}]",
+            ),
+            "scene: robot_state.multi_dof_joint_state.joint_names[1]: a second multi-DOF joint",
+        ),
+        (
+            exported.replacen("    joint_names:\n    - virtual_joint\n", "    joint_names:\n    - virtual_joint\n    - mobile_base\n", 1),
+            "scene: robot_state.multi_dof_joint_state.transforms: 1 transforms for 2 joints",
+        ),
+        (
+            exported.replacen("      frame_id: world\n    joint_names:", "      frame_id: panda_hand\n    joint_names:", 1),
+            "scene: robot_state.multi_dof_joint_state.header.frame_id: frame \"panda_hand\" is not supported",
+        ),
+        (
+            compact.replacen("      translation: [0, 0, 0]\n", "      translation: [0, 0, 0.5]\n", 1),
+            "scene: fixed_frame_transforms[0].transform: places \"world\" at translation [0.000000, 0.000000, 0.500000]",
+        ),
+        (
+            exported.replacen("  child_frame_id: panda_link0\n  transform:\n    translation:\n      x: 0.0", "  child_frame_id: panda_link0\n  transform:\n    translation:\n      x: 0.3", 1),
+            "scene: fixed_frame_transforms[0].transform: places \"panda_link0\" at translation [0.300000",
+        ),
+        (
+            compact.replace("child_frame_id: world", "child_frame_id: panda_hand"),
+            "scene: fixed_frame_transforms[0].child_frame_id: \"panda_hand\" is a robot link",
+        ),
+        (
+            compact.replace("  - child_frame_id: world", "  - header: {frame_id: map}\n    child_frame_id: odom"),
+            "scene: fixed_frame_transforms[0].header.frame_id: frame \"map\" is not supported",
+        ),
+        (
+            exported.replacen("  frame_id: ''\n    pose:", "  frame_id: camera\n    pose:", 1),
+            "scene: world.collision_objects[0].header.frame_id: frame \"camera\" is not supported",
+        ),
+        (
+            exported.replacen("  scale: 1.0", "  scale: 1.1", 1),
+            "scene: link_scale[0].scale: 1.1: not supported",
+        ),
+        (
+            exported.replacen("- link_name: panda_link7\n  padding: 0.0", "- link_name: panda_link7\n  padding: 0.02", 1),
+            "scene: link_padding[1].padding: 0.02: not supported",
+        ),
+        (
+            exported.replace("      data: []", "      data: [1, 2]"),
+            "scene: world.octomap.octomap.data: not supported: octomaps",
+        ),
+        (
+            compact.replace("world:\n", "world:\n  octomap:\n    octomap: {binary: true, id: OcTree, resolution: 0.1, data: 78DA0300}\n"),
+            "scene: world.octomap.octomap.data: not supported: octomaps",
+        ),
+        (
+            compact.replace("world:\n", "point_cloud: {}\nworld:\n"),
+            "scene: point_cloud: unknown field",
+        ),
+        (
+            exported.replacen(
+                "    meshes: []\n    mesh_poses: []\n",
+                "    meshes:\n    - triangles:\n      - vertex_indices: [0, 1, 2]\n      vertices:\n      - {x: 0, y: 0, z: 0}\n      \
+                 - {x: 0.1, y: 0, z: 0}\n      - {x: 0, y: 0.1, z: 0}\n    mesh_poses:\n    - position: {x: 0.4, y: 0, z: 0.3}\n",
+                1,
+            ),
+            "scene: world.collision_objects[0].meshes: not supported: meshes (mesh obstacles are not yet supported",
+        ),
+        (
+            exported.replacen("    meshes: []\n", "    meshes:\n    - {triangles: [[0, 1, 2]], vertices: [[0, 0, 0]]}\n", 1),
+            "scene: world.collision_objects[0].mesh_poses: 0 poses for 1 meshes",
+        ),
+        (
+            compact.replace(
+                "    - id: wall\n",
+                "    - id: bunny\n      meshes:\n        - resource: package://objects/bunny.dae\n          dimensions: [1, 1, 1]\n      \
+                 mesh_poses:\n        - position: [0.4, 0, 0.3]\n          orientation: [0, 0, 0, 1]\n    - id: wall\n",
+            ),
+            "scene: world.collision_objects[1].meshes[0].resource: a mesh file",
+        ),
+        (
+            compact.replace("type: sphere", "type: cone"),
+            "scene: world.collision_objects[3].primitives[0].type: CONE (4) is not supported",
+        ),
+        (
+            compact.replace("    - id: ball\n", "    - id: ball\n      operation: remove\n"),
+            "scene: world.collision_objects[3].operation: operation \"remove\" is not supported",
+        ),
+    ];
+    let held = |header: &str| {
+        exported.replace(
+            "  attached_collision_objects: []",
+            &format!(
+                "  attached_collision_objects:\n  - link_name: panda_hand\n    object:\n      {header}id: tool\n      \
+                 primitives: [{{type: 2, dimensions: [0.02]}}]\n      primitive_poses: [{{position: {{x: 0, y: 0, z: 0.1}}}}]"
+            ),
+        )
+    };
+    // An empty frame is the link's, as MoveIt reads it; no header is ambiguous.
+    let (doc, _) = import_validated(&held("header: {frame_id: ''}\n      "), None).unwrap();
+    assert_eq!(doc["held_object"]["center"], json!([0.0, 0.0, 0.1]));
+    cases.push((
+        held(""),
+        "scene: robot_state.attached_collision_objects[0].object: no header",
+    ));
+    for (scene, want) in cases {
+        assert_ne!(scene, exported);
+        assert_ne!(scene, compact, "{want}: the replacement did not apply");
+        let got = error(&scene, None, want);
         assert!(got.starts_with(want), "expected {want:?}, got {got:?}");
     }
 }

@@ -1,21 +1,45 @@
-//! MoveIt's planning scenes as `edmp-scene/1`: a `moveit_msgs/PlanningScene` as YAML (e.g.
-//! from `rostopic echo` / `ros2 topic echo`) and optionally a `moveit_msgs/MotionPlanRequest`
-//! (YAML) become one document, validated through the host's JSON reader.
+//! MoveIt's planning scenes as `edmp-scene/1`: a `moveit_msgs/PlanningScene` as YAML (from
+//! `rostopic echo` / `ros2 topic echo`, MoveIt's scene export, or MotionBenchMaker's robowflex
+//! files) and optionally a `moveit_msgs/MotionPlanRequest` (YAML) become one document,
+//! validated through the host's JSON reader.
 //!
-//! What is read: `world.collision_objects[]` (BOX, SPHERE, CYLINDER primitives; the world pose
-//! of each is the object's `pose` times the primitive's pose), one object attached to
-//! `panda_hand` with one primitive (the held object), the start from the request's
+//! What is read: `world.collision_objects[]` (BOX, SPHERE, CYLINDER primitives; the pose of each
+//! is its frame's, times the object's `pose`, times the primitive's pose), one object attached
+//! to `panda_hand` with one primitive (the held object), the start from the request's
 //! `start_state.joint_state` (else the scene's `robot_state.joint_state`), and the goal from
 //! `goal_constraints[0]`: joint constraints, or one position and one orientation constraint on
 //! `panda_link8`, `panda_hand` or `panda_grasptarget` (converted to the TCP). ROS quaternions
-//! are `[x, y, z, w]`; ours are `[w, x, y, z]`. Frames: `panda_link0` (our world) or `world`
-//! (the Panda MoveIt configuration's fixed virtual joint, identity).
+//! are `{x, y, z, w}`; ours are `[w, x, y, z]`. Points and quaternions may also be flow
+//! sequences (`[x, y, z]`, `[x, y, z, w]`) and primitive types names (`box`, `sphere`,
+//! `cylinder`), as robowflex writes them; an operation is ADD as `0`, `"\x00"`, `b'\x00'`,
+//! `add`, or absent.
 //!
-//! Everything that would change the problem and cannot be expressed (meshes, planes, cones,
-//! other frames, other links, octomaps, path constraints, padding, a second goal) is an error
-//! naming its YAML path; fields that do not change the geometry or the ends (names, stamps,
-//! colours, planner settings, the allowed collision matrix, which only ever permits contacts)
-//! are ignored. Unknown fields are errors, as in `edmp-scene/1`.
+//! Frames. Our world is `panda_link0`, the Panda's base. MoveIt's planning frame is `world`;
+//! an absent header or an empty `frame_id` names it. Where it is relative to the base:
+//! - `multi_dof_joint_state` (the scene's robot state, or the request's start state, which wins
+//!   as MoveIt merges it): at most one joint, of any name (MoveIt's Panda: `virtual_joint`),
+//!   its parent the planning frame; its transform places `panda_link0` in `world`, and everything
+//!   given in `world` is brought into the base frame by its inverse. Within 1e-9 of the
+//!   identity it is the identity. Its twist and wrench, and joint velocities and efforts, are
+//!   ignored: a plan is positions. A second multi-DOF joint is an error.
+//! - no such joint: `world` is `panda_link0`.
+//! - `fixed_frame_transforms` (`geometry_msgs/TransformStamped`, parent the header's frame, empty
+//!   the planning frame): each child is a frame that objects and goal constraints may name; one
+//!   the importer already places (`world`, `panda_link0`) must agree with it to 1e-6 (an
+//!   identity `world` → `panda_link0` does, with no or an identity virtual joint); a robot link
+//!   other than the base is an error (the joint state places it).
+//!
+//! An attached object's frame is `panda_hand`, or empty (its link's, as MoveIt reads it); an
+//! attached object without a header is refused (robowflex would read it as `world`).
+//!
+//! Everything that would change the problem and cannot be expressed is an error naming its YAML
+//! path: planes, cones, meshes (read and checked by `mesh`, then refused until the scene
+//! reader takes mesh obstacles; mesh files by `resource` are refused), octomap data, unknown
+//! frames and links, padding ≠ 0 or scale ≠ 1, operations other than ADD, path constraints, a
+//! second goal. Fields that do not change the geometry or the ends are read and ignored: names,
+//! stamps, `is_diff`, `robot_model_name` (`panda` or empty), colours, subframes, object types,
+//! planner settings, and the allowed collision matrix (it only ever permits contacts; the
+//! checker checks every pair the spec names). Unknown fields are errors, as in `edmp-scene/1`.
 
 use crate::formats::json::{Problem, parse_problem};
 use core::fmt;
@@ -31,9 +55,15 @@ const FINGER_OPENING: f64 = 0.025;
 const FINGER_TOLERANCE: f64 = 1e-6;
 /// How far a quaternion's norm may be from 1 (the scene format's own rule).
 const NORM_TOLERANCE: f64 = 1e-3;
-/// Frames we read as the world: our world is `panda_link0`; MoveIt's Panda configuration puts
-/// it at `world` through a fixed identity virtual joint.
-const WORLD_FRAMES: [&str; 2] = ["panda_link0", "world"];
+/// Our world: the Panda's base link.
+const BASE_FRAME: &str = "panda_link0";
+/// MoveIt's planning frame (the Panda configuration's virtual joint's parent); an empty or
+/// absent frame is this one.
+const PLANNING_FRAME: &str = "world";
+/// How far a virtual joint's transform may be from the identity and be read as it (m, rad).
+const IDENTITY_TOLERANCE: f64 = 1e-9;
+/// How far two placements of one frame may differ and still agree (m, rad).
+const AGREEMENT_TOLERANCE: f64 = 1e-6;
 /// Finger joints: one opening for the whole plan (`gripper.finger`).
 const FINGER_JOINTS: [&str; 2] = ["panda_finger_joint1", "panda_finger_joint2"];
 
@@ -211,7 +241,24 @@ fn string<'a>(map: Option<&'a Map<String, Value>>, path: &str, key: &str) -> R<&
     }
 }
 
+/// `N` numbers written as a flow sequence (`[x, y, z]`, as MotionBenchMaker's robowflex writes
+/// points and quaternions).
+fn numbers<const N: usize>(items: &[Value], path: &str) -> R<[f64; N]> {
+    if items.len() != N {
+        return Err(at(path, format!("expected {N} numbers, found {}", items.len())));
+    }
+    let mut out = [0.0; N];
+    for (i, (slot, x)) in out.iter_mut().zip(items).enumerate() {
+        *slot = number(x, &format!("{path}[{i}]"))?;
+    }
+    Ok(out)
+}
+
+/// A `geometry_msgs/Vector3` or `Point`: `{x, y, z}` (absent fields 0) or `[x, y, z]`.
 fn vector(v: Option<&Value>, path: &str) -> R<Vector3<f64>> {
+    if let Some(Value::Array(items)) = v {
+        return numbers::<3>(items, path).map(Vector3::from);
+    }
     let map = mapping(v.unwrap_or(&Value::Null), path, &["x", "y", "z"])?;
     Ok(Vector3::new(
         number_or_zero(map, path, "x")?,
@@ -220,16 +267,21 @@ fn vector(v: Option<&Value>, path: &str) -> R<Vector3<f64>> {
     ))
 }
 
-/// A ROS quaternion `{x, y, z, w}`. All zeros is the identity (MoveIt's own reading of an unset
-/// orientation); otherwise the norm must be within 1e-3 of 1.
+/// A ROS quaternion `{x, y, z, w}` or `[x, y, z, w]`. All zeros is the identity (MoveIt's own
+/// reading of an unset orientation); otherwise the norm must be within 1e-3 of 1.
 fn orientation(v: Option<&Value>, path: &str) -> R<UnitQuaternion<f64>> {
-    let map = mapping(v.unwrap_or(&Value::Null), path, &["x", "y", "z", "w"])?;
-    let q = Quaternion::new(
-        number_or_zero(map, path, "w")?,
-        number_or_zero(map, path, "x")?,
-        number_or_zero(map, path, "y")?,
-        number_or_zero(map, path, "z")?,
-    );
+    let q = if let Some(Value::Array(items)) = v {
+        let [x, y, z, w] = numbers::<4>(items, path)?;
+        Quaternion::new(w, x, y, z)
+    } else {
+        let map = mapping(v.unwrap_or(&Value::Null), path, &["x", "y", "z", "w"])?;
+        Quaternion::new(
+            number_or_zero(map, path, "w")?,
+            number_or_zero(map, path, "x")?,
+            number_or_zero(map, path, "y")?,
+            number_or_zero(map, path, "z")?,
+        )
+    };
     let norm = q.norm();
     if norm == 0.0 {
         return Ok(UnitQuaternion::identity());
@@ -248,8 +300,9 @@ fn pose(v: Option<&Value>, path: &str) -> R<Isometry3<f64>> {
     Ok(Isometry3::from_parts(Translation3::from(position), rotation))
 }
 
-/// The frame of a `std_msgs/Header`, which must be one of `allowed`.
-fn frame(map: Option<&Map<String, Value>>, path: &str, allowed: &[&str]) -> R<String> {
+/// The frame of a `std_msgs/Header` (leading `/` dropped); absent or empty: `""`, the planning
+/// frame.
+fn frame_id(map: Option<&Map<String, Value>>, path: &str) -> R<String> {
     let hp = join(path, "header");
     let header = mapping(
         map.and_then(|m| m.get("header")).unwrap_or(&Value::Null),
@@ -257,14 +310,114 @@ fn frame(map: Option<&Map<String, Value>>, path: &str, allowed: &[&str]) -> R<St
         &["seq", "stamp", "frame_id"],
     )?;
     let id = string(header, &hp, "frame_id")?;
-    let id = id.strip_prefix('/').unwrap_or(id);
-    if allowed.contains(&id) {
-        Ok(id.to_owned())
-    } else {
-        Err(at(
-            &join(&hp, "frame_id"),
-            format!("frame {id:?} is not supported (only {})", allowed.join(", ")),
-        ))
+    Ok(id.strip_prefix('/').unwrap_or(id).to_owned())
+}
+
+/// Whether `p` is the identity to [`IDENTITY_TOLERANCE`].
+fn is_identity(p: &Isometry3<f64>) -> bool {
+    p.translation.vector.norm() <= IDENTITY_TOLERANCE && p.rotation.angle() <= IDENTITY_TOLERANCE
+}
+
+/// Whether `a` and `b` agree to [`AGREEMENT_TOLERANCE`].
+fn agree(a: &Isometry3<f64>, b: &Isometry3<f64>) -> bool {
+    let d = a.inverse() * b;
+    d.translation.vector.norm() <= AGREEMENT_TOLERANCE && d.rotation.angle() <= AGREEMENT_TOLERANCE
+}
+
+fn describe(p: &Isometry3<f64>) -> String {
+    let t = p.translation.vector;
+    let (axis, angle) = p
+        .rotation
+        .axis_angle()
+        .map_or((Vector3::z(), 0.0), |(a, angle)| (a.into_inner(), angle));
+    format!(
+        "translation [{:.6}, {:.6}, {:.6}], rotation {:.6} rad about [{:.4}, {:.4}, {:.4}]",
+        t.x, t.y, t.z, angle, axis.x, axis.y, axis.z
+    )
+}
+
+/// The frames objects and goals may name, each with its pose in our world (`panda_link0`, the
+/// Panda's base): the planning frame (`world`, or an empty frame), the base, and the children
+/// of `fixed_frame_transforms`.
+#[derive(Debug)]
+struct Frames {
+    known: Vec<(String, Isometry3<f64>)>,
+}
+
+impl Frames {
+    /// `base`: where the virtual joint places `panda_link0` in the planning frame.
+    fn new(base: &Isometry3<f64>) -> Self {
+        Self {
+            known: vec![
+                (BASE_FRAME.to_owned(), Isometry3::identity()),
+                (PLANNING_FRAME.to_owned(), base.inverse()),
+            ],
+        }
+    }
+
+    fn get(&self, id: &str) -> Option<&Isometry3<f64>> {
+        let id = if id.is_empty() { PLANNING_FRAME } else { id };
+        self.known.iter().find(|(n, _)| n == id).map(|(_, p)| p)
+    }
+
+    /// The pose in our world of frame `id`, named at `path`.
+    fn pose(&self, id: &str, path: &str) -> R<Isometry3<f64>> {
+        self.get(id).copied().ok_or_else(|| {
+            let names: Vec<&str> = self.known.iter().map(|(n, _)| n.as_str()).collect();
+            at(
+                path,
+                format!(
+                    "frame {id:?} is not supported (known: {}; empty is world, the planning frame)",
+                    names.join(", ")
+                ),
+            )
+        })
+    }
+
+    /// Reads `fixed_frame_transforms` (`geometry_msgs/TransformStamped`s): each child becomes a
+    /// frame objects may name; one the importer already knows (the planning frame, the base)
+    /// must agree with it; a robot link other than the base is refused (the joint state
+    /// places it).
+    fn read_fixed(&mut self, items: &[Value], path: &str) -> R<()> {
+        for (i, item) in items.iter().enumerate() {
+            let ip = format!("{path}[{i}]");
+            let m = mapping(item, &ip, &["header", "child_frame_id", "transform"])?;
+            let parent_id = frame_id(m, &ip)?;
+            let parent = self.pose(&parent_id, &join(&ip, "header.frame_id"))?;
+            let tp = join(&ip, "transform");
+            let t = mapping(
+                m.and_then(|m| m.get("transform")).unwrap_or(&Value::Null),
+                &tp,
+                &["translation", "rotation"],
+            )?;
+            let translation = vector(t.and_then(|t| t.get("translation")), &join(&tp, "translation"))?;
+            let rotation = orientation(t.and_then(|t| t.get("rotation")), &join(&tp, "rotation"))?;
+            let placed = parent * Isometry3::from_parts(Translation3::from(translation), rotation);
+            let child = string(m, &ip, "child_frame_id")?;
+            let child = child.strip_prefix('/').unwrap_or(child);
+            let cp = join(&ip, "child_frame_id");
+            if let Some(known) = self.get(child) {
+                if !agree(known, &placed) {
+                    return Err(at(
+                        &tp,
+                        format!(
+                            "places {:?} at {} in panda_link0, but it is at {} (the robot state's virtual joint places the base; the planning frame is world)",
+                            if child.is_empty() { PLANNING_FRAME } else { child },
+                            describe(&placed),
+                            describe(known),
+                        ),
+                    ));
+                }
+            } else if FRAME_NAMES.contains(&child) {
+                return Err(at(
+                    &cp,
+                    format!("{child:?} is a robot link: the joint state places it, not a fixed transform"),
+                ));
+            } else {
+                self.known.push((child.to_owned(), placed));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -289,10 +442,16 @@ fn center_and_quaternion(p: &Isometry3<f64>) -> (Vec<f64>, Vec<f64>) {
 fn primitive(v: &Value, path: &str, placed: &Isometry3<f64>) -> R<Value> {
     let map = mapping(v, path, &["type", "dimensions"])?;
     let tp = join(path, "type");
-    let kind = map
-        .and_then(|m| m.get("type"))
-        .and_then(Value::as_u64)
-        .ok_or_else(|| at(&tp, "expected the primitive type (1 BOX, 2 SPHERE, 3 CYLINDER)"))?;
+    // ROS writes the type's number; robowflex (MotionBenchMaker) its name.
+    let kind = match map.and_then(|m| m.get("type")) {
+        Some(Value::Number(n)) => n.as_u64(),
+        Some(Value::String(name)) => ["box", "sphere", "cylinder", "cone"]
+            .iter()
+            .position(|k| k.eq_ignore_ascii_case(name))
+            .map(|k| k as u64 + 1),
+        _ => None,
+    }
+    .ok_or_else(|| at(&tp, "expected the primitive type (1 BOX, 2 SPHERE, 3 CYLINDER)"))?;
     let (dims, dp) = sequence(map, path, "dimensions")?;
     let dims = dims
         .iter()
@@ -330,6 +489,67 @@ fn primitive(v: &Value, path: &str, placed: &Isometry3<f64>) -> R<Value> {
     }
 }
 
+/// One `shape_msgs/Mesh` placed at `placed`, as an `edmp-scene/1` mesh obstacle: `vertices`
+/// (`{x, y, z}` or `[x, y, z]`, in the mesh's frame) and `triangles` (`{vertex_indices: [i, j,
+/// k]}` or `[i, j, k]`). The scene reader does not accept mesh obstacles yet, so
+/// [`collision_object`] checks meshes with this and then refuses them.
+fn mesh(v: &Value, path: &str, placed: &Isometry3<f64>) -> R<Value> {
+    let map = mapping(v, path, &["vertices", "triangles", "resource", "dimensions"])?;
+    if map.is_some_and(|m| m.contains_key("resource")) {
+        return Err(at(
+            &join(path, "resource"),
+            "a mesh file: the vertices and triangles must be in the YAML",
+        ));
+    }
+    let (vertices, vp) = sequence(map, path, "vertices")?;
+    let (triangles, tp) = sequence(map, path, "triangles")?;
+    if vertices.is_empty() {
+        return Err(at(&vp, "missing: a mesh has vertices"));
+    }
+    if triangles.is_empty() {
+        return Err(at(&tp, "missing: a mesh has triangles"));
+    }
+    let vertices = vertices
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let p = vector(Some(x), &format!("{vp}[{i}]"))?;
+            Ok(json!([round(p.x), round(p.y), round(p.z)]))
+        })
+        .collect::<R<Vec<Value>>>()?;
+    let triangles = triangles
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let ip = format!("{tp}[{i}]");
+            let (indices, ip) = match t {
+                Value::Array(items) => (items.as_slice(), ip),
+                _ => sequence(mapping(t, &ip, &["vertex_indices"])?, &ip, "vertex_indices")?,
+            };
+            if indices.len() != 3 {
+                return Err(at(&ip, format!("expected 3 vertex indices, found {}", indices.len())));
+            }
+            indices
+                .iter()
+                .enumerate()
+                .map(|(k, x)| match x.as_u64() {
+                    Some(n) if (n as usize) < vertices.len() => Ok(json!(n)),
+                    _ => Err(at(
+                        &format!("{ip}[{k}]"),
+                        format!("{x} is not a vertex index (0..{})", vertices.len()),
+                    )),
+                })
+                .collect::<R<Vec<Value>>>()
+                .map(Value::Array)
+        })
+        .collect::<R<Vec<Value>>>()?;
+    let (center, quaternion) = center_and_quaternion(placed);
+    Ok(json!({
+        "type": "mesh", "vertices": vertices, "triangles": triangles, "center": center,
+        "quaternion": quaternion, "scale": 1,
+    }))
+}
+
 const COLLISION_OBJECT: [&str; 13] = [
     "header",
     "pose",
@@ -346,16 +566,43 @@ const COLLISION_OBJECT: [&str; 13] = [
     "operation",
 ];
 
-/// A `moveit_msgs/CollisionObject`: its primitives, in `frames` (the world, or the hand for an
-/// attached object), as `edmp-scene/1` primitives.
-fn collision_object(v: &Value, path: &str, frames: &[&str]) -> R<(String, Vec<Value>)> {
+/// Where a collision object's frame is: our world's `frames`, or (attached objects) the hand.
+#[derive(Clone, Copy)]
+enum ObjectFrames<'a> {
+    World(&'a Frames),
+    Hand,
+}
+
+/// A `moveit_msgs/CollisionObject`: its primitives, placed in our world (or, for an attached
+/// object, in the hand frame), as `edmp-scene/1` primitives.
+fn collision_object(v: &Value, path: &str, frames: ObjectFrames<'_>) -> R<(String, Vec<Value>)> {
     let map = mapping(v, path, &COLLISION_OBJECT)?;
     let id = string(map, path, "id")?.to_owned();
-    frame(map, path, frames)?;
+    let fid = frame_id(map, path)?;
+    let frame = match frames {
+        ObjectFrames::World(frames) => frames.pose(&fid, &join(path, "header.frame_id"))?,
+        // No header at all: ROS reads an empty frame (for an attached object, its link's),
+        // robowflex `world`. Not guessed.
+        ObjectFrames::Hand if map.is_none_or(|m| !m.contains_key("header")) => {
+            return Err(at(
+                path,
+                "no header: an attached object's frame is ambiguous without one (ROS reads its link's, MotionBenchMaker's robowflex world); give header.frame_id panda_hand",
+            ));
+        }
+        // MoveIt reads an attached object's empty frame as its link's.
+        ObjectFrames::Hand if fid.is_empty() || fid == FRAME_NAMES[HAND_FRAME] => Isometry3::identity(),
+        ObjectFrames::Hand => {
+            return Err(at(
+                &join(path, "header.frame_id"),
+                format!("frame {fid:?} is not supported (only panda_hand, or empty)"),
+            ));
+        }
+    };
     match map.and_then(|m| m.get("operation")) {
         None | Some(Value::Null) => {}
         Some(Value::Number(n)) if n.as_u64() == Some(0) => {}
-        Some(Value::String(s)) if s == "\0" || s == "b'\\x00'" => {}
+        // Byte 0 as YAML writes it ("\x00", b'\x00'), or robowflex's name.
+        Some(Value::String(s)) if s == "\0" || s == "b'\\x00'" || s.eq_ignore_ascii_case("add") => {}
         Some(other) => {
             return Err(at(
                 &join(path, "operation"),
@@ -363,9 +610,28 @@ fn collision_object(v: &Value, path: &str, frames: &[&str]) -> R<(String, Vec<Va
             ));
         }
     }
-    unsupported_if_any(map, path, "meshes", "meshes (cuboid, sphere, cylinder primitives only)")?;
     unsupported_if_any(map, path, "planes", "planes (cuboid, sphere, cylinder primitives only)")?;
-    let object_pose = pose(map.and_then(|m| m.get("pose")), &join(path, "pose"))?;
+    let object_pose = frame * pose(map.and_then(|m| m.get("pose")), &join(path, "pose"))?;
+    let (meshes, mp) = sequence(map, path, "meshes")?;
+    let (mesh_poses, mpp) = sequence(map, path, "mesh_poses")?;
+    if meshes.len() != mesh_poses.len() {
+        return Err(at(
+            &mpp,
+            format!("{} poses for {} meshes", mesh_poses.len(), meshes.len()),
+        ));
+    }
+    let mut out = Vec::new();
+    for (i, (m, p)) in meshes.iter().zip(mesh_poses).enumerate() {
+        let placed = object_pose * pose(Some(p), &format!("{mpp}[{i}]"))?;
+        out.push(mesh(m, &format!("{mp}[{i}]"), &placed)?);
+    }
+    if !out.is_empty() {
+        // Read and checked; `out` keeps them once the scene reader takes mesh obstacles.
+        return Err(at(
+            &mp,
+            "not supported: meshes (mesh obstacles are not yet supported by edmp-scene/1; cuboid, sphere, cylinder primitives only)",
+        ));
+    }
     let (primitives, pp) = sequence(map, path, "primitives")?;
     let (poses, posep) = sequence(map, path, "primitive_poses")?;
     if primitives.len() != poses.len() {
@@ -374,7 +640,6 @@ fn collision_object(v: &Value, path: &str, frames: &[&str]) -> R<(String, Vec<Va
             format!("{} poses for {} primitives", poses.len(), primitives.len()),
         ));
     }
-    let mut out = Vec::new();
     for (i, (prim, p)) in primitives.iter().zip(poses).enumerate() {
         let placed = object_pose * pose(Some(p), &format!("{posep}[{i}]"))?;
         out.push(primitive(prim, &format!("{pp}[{i}]"), &placed)?);
@@ -407,7 +672,7 @@ fn attached(items: &[Value], path: &str) -> R<Option<(String, Value)>> {
         let (id, mut prims) = collision_object(
             map.and_then(|m| m.get("object")).unwrap_or(&Value::Null),
             &op,
-            &["", FRAME_NAMES[HAND_FRAME]],
+            ObjectFrames::Hand,
         )?;
         if prims.len() != 1 {
             return Err(at(
@@ -436,21 +701,15 @@ struct State {
     joints: Option<[f64; JOINTS]>,
     held: Option<(String, Value)>,
     fingers: Fingers,
+    /// Where the virtual joint places `panda_link0` in the planning frame, if it is given.
+    base: Option<Isometry3<f64>>,
 }
 
 fn robot_state(v: &Value, path: &str) -> R<State> {
     let map = mapping(v, path, &ROBOT_STATE)?;
-    let mdp = join(path, "multi_dof_joint_state");
-    let mdof = mapping(
+    let base = base_placement(
         map.and_then(|m| m.get("multi_dof_joint_state")).unwrap_or(&Value::Null),
-        &mdp,
-        &["header", "joint_names", "transforms", "twist", "wrench"],
-    )?;
-    unsupported_if_any(
-        mdof,
-        &mdp,
-        "joint_names",
-        "multi-DOF joints (the Panda's base is fixed)",
+        &join(path, "multi_dof_joint_state"),
     )?;
     let (items, ap) = sequence(map, path, "attached_collision_objects")?;
     let held = attached(items, &ap)?;
@@ -465,6 +724,7 @@ fn robot_state(v: &Value, path: &str) -> R<State> {
     if names.is_empty() && positions.is_empty() {
         return Ok(State {
             held,
+            base,
             ..State::default()
         });
     }
@@ -487,7 +747,55 @@ fn robot_state(v: &Value, path: &str) -> R<State> {
         joints: Some(complete(joints, &np)?),
         held,
         fingers,
+        base,
     })
+}
+
+/// A `sensor_msgs/MultiDOFJointState`: at most one joint (any name; MoveIt's Panda calls it
+/// `virtual_joint`), whose transform places `panda_link0` in the planning frame. Its twist and
+/// wrench are ignored (a plan is positions; MoveIt's planners ignore start velocities too).
+fn base_placement(v: &Value, path: &str) -> R<Option<Isometry3<f64>>> {
+    let map = mapping(v, path, &["header", "joint_names", "transforms", "twist", "wrench"])?;
+    let (names, np) = sequence(map, path, "joint_names")?;
+    let (transforms, tp) = sequence(map, path, "transforms")?;
+    if names.len() != transforms.len() {
+        return Err(at(
+            &tp,
+            format!("{} transforms for {} joints", transforms.len(), names.len()),
+        ));
+    }
+    match names.len() {
+        0 => return Ok(None),
+        1 => {}
+        _ => {
+            return Err(at(
+                &format!("{np}[1]"),
+                "a second multi-DOF joint: the Panda has one, the virtual joint that places its base",
+            ));
+        }
+    }
+    if !names[0].is_string() {
+        return Err(at(&format!("{np}[0]"), "expected a joint name"));
+    }
+    let parent = frame_id(map, path)?;
+    if !(parent.is_empty() || parent == PLANNING_FRAME) {
+        return Err(at(
+            &join(path, "header.frame_id"),
+            format!(
+                "frame {parent:?} is not supported (the virtual joint's parent is the planning frame: world, or empty)"
+            ),
+        ));
+    }
+    let t0 = format!("{tp}[0]");
+    let t = mapping(&transforms[0], &t0, &["translation", "rotation"])?;
+    let translation = vector(t.and_then(|t| t.get("translation")), &join(&t0, "translation"))?;
+    let rotation = orientation(t.and_then(|t| t.get("rotation")), &join(&t0, "rotation"))?;
+    let placed = Isometry3::from_parts(Translation3::from(translation), rotation);
+    Ok(Some(if is_identity(&placed) {
+        Isometry3::identity()
+    } else {
+        placed
+    }))
 }
 
 /// Records joint `name` = `x` (a finger's opening goes to `fingers`, with its path).
@@ -545,7 +853,7 @@ fn tcp_offset(link: &str, path: &str) -> R<Isometry3<f64>> {
 }
 
 /// The goal of `moveit_msgs/Constraints`: joints (and finger openings), or the TCP pose.
-fn goal(v: &Value, path: &str) -> R<(Value, Fingers)> {
+fn goal(v: &Value, path: &str, frames: &Frames) -> R<(Value, Fingers)> {
     let map = mapping(
         v,
         path,
@@ -616,8 +924,8 @@ fn goal(v: &Value, path: &str) -> R<(Value, Fingers)> {
             "weight",
         ],
     )?;
-    frame(pm, &pp, &WORLD_FRAMES)?;
-    frame(om, &op, &WORLD_FRAMES)?;
+    let pframe = frames.pose(&frame_id(pm, &pp)?, &join(&pp, "header.frame_id"))?;
+    let oframe = frames.pose(&frame_id(om, &op)?, &join(&op, "header.frame_id"))?;
     let link = string(pm, &pp, "link_name")?;
     let olink = string(om, &op, "link_name")?;
     if link != olink {
@@ -651,10 +959,10 @@ fn goal(v: &Value, path: &str) -> R<(Value, Fingers)> {
                 "missing: the target position is the region's primitive pose",
             ));
         }
-        [p] => pose(Some(p), &format!("{posep}[0]"))?.translation.vector,
+        [p] => (pframe * pose(Some(p), &format!("{posep}[0]"))?).translation.vector,
         _ => return Err(at(&posep, "more than one region: the target must be one point")),
     };
-    let rotation = orientation(om.and_then(|m| m.get("orientation")), &join(&op, "orientation"))?;
+    let rotation = oframe.rotation * orientation(om.and_then(|m| m.get("orientation")), &join(&op, "orientation"))?;
     // The constrained point is `link · point_offset`; place the link so it lands on the target.
     let link_pose = Isometry3::from_parts(Translation3::from(target - rotation * point_offset), rotation);
     let (position, quaternion) = center_and_quaternion(&(link_pose * offset));
@@ -696,7 +1004,10 @@ fn link_adjustments(map: Option<&Map<String, Value>>, key: &str, neutral: f64) -
     Ok(())
 }
 
-fn scene_part(v: &Value) -> R<(Vec<Value>, Vec<String>, State)> {
+/// The scene's obstacles (with their ids), its robot state, and its frames. `request_base`:
+/// the request's start state's virtual joint, which (as MoveIt merges a start state into the
+/// scene's) places the base instead of the scene's own.
+fn scene_part(v: &Value, request_base: Option<Isometry3<f64>>) -> R<(Vec<Value>, Vec<String>, State, Frames)> {
     let map = mapping(v, "", &PLANNING_SCENE)?;
     let model = string(map, "", "robot_model_name")?;
     if !model.is_empty() && model != "panda" {
@@ -708,6 +1019,10 @@ fn scene_part(v: &Value) -> R<(Vec<Value>, Vec<String>, State)> {
         Some(rs) => robot_state(rs, "robot_state")?,
         None => State::default(),
     };
+    let base = request_base.or(state.base).unwrap_or_else(Isometry3::identity);
+    let mut frames = Frames::new(&base);
+    let (fixed, fp) = sequence(map, "", "fixed_frame_transforms")?;
+    frames.read_fixed(fixed, &fp)?;
     let world = mapping(
         map.and_then(|m| m.get("world")).unwrap_or(&Value::Null),
         "world",
@@ -720,19 +1035,30 @@ fn scene_part(v: &Value) -> R<(Vec<Value>, Vec<String>, State)> {
             "world.octomap.octomap",
             &["header", "binary", "id", "resolution", "data"],
         )?;
-        unsupported_if_any(inner, "world.octomap.octomap", "data", "octomaps (primitives only)")?;
+        // A sequence of bytes (ROS), or robowflex's compressed hex string.
+        match inner.and_then(|m| m.get("data")) {
+            None | Some(Value::Null) => {}
+            Some(Value::Array(a)) if a.is_empty() => {}
+            Some(Value::String(h)) if h.is_empty() => {}
+            Some(_) => {
+                return Err(at(
+                    "world.octomap.octomap.data",
+                    "not supported: octomaps (primitives only)",
+                ));
+            }
+        }
     }
     let (objects, op) = sequence(world, "world", "collision_objects")?;
     let mut obstacles = Vec::new();
     let mut ids = Vec::new();
     for (i, o) in objects.iter().enumerate() {
-        let (id, prims) = collision_object(o, &format!("{op}[{i}]"), &WORLD_FRAMES)?;
+        let (id, prims) = collision_object(o, &format!("{op}[{i}]"), ObjectFrames::World(&frames))?;
         for p in prims {
             obstacles.push(p);
             ids.push(id.clone());
         }
     }
-    Ok((obstacles, ids, state))
+    Ok((obstacles, ids, state, frames))
 }
 
 const MOTION_PLAN_REQUEST: [&str; 16] = [
@@ -754,7 +1080,8 @@ const MOTION_PLAN_REQUEST: [&str; 16] = [
     "max_cartesian_speed",
 ];
 
-fn request_part(v: &Value) -> R<(State, (Value, Fingers))> {
+/// The request's start state, after its checks (group, path and trajectory constraints).
+fn request_start(v: &Value) -> R<State> {
     let map = mapping(v, "", &MOTION_PLAN_REQUEST)?;
     let group = string(map, "", "group_name")?;
     if !["", "panda_arm", "panda_manipulator"].contains(&group) {
@@ -789,17 +1116,21 @@ fn request_part(v: &Value) -> R<(State, (Value, Fingers))> {
         unsupported_if_any(tm, "trajectory_constraints", "constraints", "trajectory constraints")?;
     }
     unsupported_if_any(map, "", "reference_trajectories", "reference trajectories")?;
-    let state = match map.and_then(|m| m.get("start_state")) {
-        Some(s) => robot_state(s, "start_state")?,
-        None => State::default(),
-    };
+    match map.and_then(|m| m.get("start_state")) {
+        Some(s) => robot_state(s, "start_state"),
+        None => Ok(State::default()),
+    }
+}
+
+/// The request's goal, its frames resolved through the scene's.
+fn request_goal(v: &Value, frames: &Frames) -> R<(Value, Fingers)> {
+    let map = mapping(v, "", &MOTION_PLAN_REQUEST)?;
     let (goals, gp) = sequence(map, "", "goal_constraints")?;
-    let goal = match goals {
-        [] => return Err(at(&gp, "missing: the request has no goal")),
-        [g] => goal(g, &format!("{gp}[0]"))?,
-        _ => return Err(at(&format!("{gp}[1]"), "a second goal: edmp-scene/1 has one")),
-    };
-    Ok((state, goal))
+    match goals {
+        [] => Err(at(&gp, "missing: the request has no goal")),
+        [g] => goal(g, &format!("{gp}[0]"), frames),
+        _ => Err(at(&format!("{gp}[1]"), "a second goal: edmp-scene/1 has one")),
+    }
 }
 
 /// Reads a MoveIt `PlanningScene` (and optionally a `MotionPlanRequest`) into an
@@ -817,10 +1148,17 @@ pub fn import(scene_yaml: &str, request_yaml: Option<&str>) -> Result<Value, Imp
         path: e.path,
         message: e.message,
     };
-    let (obstacles, ids, scene_state) = load(scene_yaml).and_then(|v| scene_part(&v)).map_err(in_scene)?;
-    let request = match request_yaml {
-        Some(text) => Some(load(text).and_then(|v| request_part(&v)).map_err(in_request)?),
+    let scene_doc = load(scene_yaml).map_err(in_scene)?;
+    let request_doc = request_yaml.map(load).transpose().map_err(in_request)?;
+    let request_state = match &request_doc {
+        Some(v) => Some(request_start(v).map_err(in_request)?),
         None => None,
+    };
+    let (obstacles, ids, scene_state, frames) =
+        scene_part(&scene_doc, request_state.as_ref().and_then(|s| s.base)).map_err(in_scene)?;
+    let request = match (request_state, &request_doc) {
+        (Some(state), Some(v)) => Some((state, request_goal(v, &frames).map_err(in_request)?)),
+        _ => None,
     };
     let tag = |fingers: Fingers, source: Source| {
         fingers
@@ -909,4 +1247,99 @@ pub fn import_validated(scene_yaml: &str, request_yaml: Option<&str>) -> Result<
     let problem =
         parse_problem(&doc.to_string()).map_err(|e| format!("the imported edmp-scene/1 is not valid: {e}"))?;
     Ok((doc, problem))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn yaml(text: &str) -> Value {
+        load(text).unwrap()
+    }
+
+    #[test]
+    fn a_mesh_becomes_the_scene_formats_mesh_obstacle() {
+        // shape_msgs/Mesh as ROS writes it, placed 1 m up and yawed 90°.
+        let v = yaml(
+            "triangles:\n- vertex_indices: [0, 1, 2]\n- vertex_indices: [0, 2, 3]\nvertices:\n\
+             - {x: 0.0, y: 0.0, z: 0.0}\n- {x: 0.1, y: 0.0, z: 0.0}\n- {x: 0.1, y: 0.1, z: 0.0}\n- {x: 0, y: 0.1, z: 0}\n",
+        );
+        let placed = Isometry3::from_parts(
+            Translation3::new(0.0, 0.0, 1.0),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), core::f64::consts::FRAC_PI_2),
+        );
+        let h = core::f64::consts::FRAC_1_SQRT_2;
+        let want = json!({
+            "type": "mesh",
+            "vertices": [[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.1, 0.0], [0.0, 0.1, 0.0]],
+            "triangles": [[0, 1, 2], [0, 2, 3]],
+            "center": [0.0, 0.0, 1.0],
+            "quaternion": [round(h), 0.0, 0.0, round(h)],
+            "scale": 1,
+        });
+        assert_eq!(mesh(&v, "m", &placed).unwrap(), want);
+        // robowflex's compact form: the same mesh.
+        let compact =
+            yaml("triangles: [[0, 1, 2], [0, 2, 3]]\nvertices: [[0, 0, 0], [0.1, 0, 0], [0.1, 0.1, 0], [0, 0.1, 0]]\n");
+        assert_eq!(mesh(&compact, "m", &placed).unwrap(), want);
+    }
+
+    #[test]
+    fn a_bad_mesh_names_its_path() {
+        let id = Isometry3::identity();
+        let cases = [
+            (
+                "triangles: [[0, 1, 3]]\nvertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]",
+                "m.triangles[0][2]",
+                "3 is not a vertex index (0..3)",
+            ),
+            (
+                "triangles: [{vertex_indices: [0, 1]}]\nvertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]",
+                "m.triangles[0].vertex_indices",
+                "expected 3 vertex indices, found 2",
+            ),
+            (
+                "triangles: []\nvertices: [[0, 0, 0]]",
+                "m.triangles",
+                "missing: a mesh has triangles",
+            ),
+            ("vertices: []", "m.vertices", "missing: a mesh has vertices"),
+            (
+                "resource: package://x/bunny.dae\ndimensions: [1, 1, 1]",
+                "m.resource",
+                "a mesh file",
+            ),
+            (
+                "triangles: [[0, 1, 2]]\nvertices: [[0, 0], [1, 0, 0], [0, 1, 0]]",
+                "m.vertices[0]",
+                "expected 3 numbers, found 2",
+            ),
+        ];
+        for (text, path, message) in cases {
+            let e = mesh(&yaml(text), "m", &id).unwrap_err();
+            assert_eq!(e.path, path, "{text}");
+            assert!(e.message.starts_with(message), "{text}: {}", e.message);
+        }
+    }
+
+    #[test]
+    fn the_virtual_joint_places_the_base() {
+        let none = base_placement(&yaml("joint_names: []\ntransforms: []"), "s").unwrap();
+        assert!(none.is_none());
+        // Near the identity reads as the identity exactly.
+        let near =
+            yaml("joint_names: [virtual_joint]\ntransforms: [{translation: [1e-12, 0, 0], rotation: [0, 0, 0, 1]}]");
+        assert_eq!(base_placement(&near, "s").unwrap(), Some(Isometry3::identity()));
+        let moved = yaml(
+            "joint_names: [base]\ntransforms: [{translation: {x: 1, y: 2, z: 0}, rotation: {x: 0, y: 0, z: 0, w: 1}}]",
+        );
+        let p = base_placement(&moved, "s").unwrap().unwrap();
+        assert_eq!(p.translation.vector, Vector3::new(1.0, 2.0, 0.0));
+        let two = yaml("joint_names: [a, b]\ntransforms: [{}, {}]");
+        assert_eq!(base_placement(&two, "s").unwrap_err().path, "s.joint_names[1]");
+        let short = yaml("joint_names: [a]\ntransforms: []");
+        assert_eq!(base_placement(&short, "s").unwrap_err().path, "s.transforms");
+        let frame = yaml("header: {frame_id: panda_link0}\njoint_names: [a]\ntransforms: [{}]");
+        assert_eq!(base_placement(&frame, "s").unwrap_err().path, "s.header.frame_id");
+    }
 }
