@@ -252,3 +252,170 @@ fn ascii_stl(bytes: &[u8]) -> Result<TriangleMesh, FileError> {
     }
     Ok(mesh)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn message(result: Result<TriangleMesh, FileError>) -> String {
+        result.expect_err("should be refused").to_string()
+    }
+
+    /// A binary STL with the given 80-byte header start and triangles (corners only).
+    fn binary(header: &[u8], triangles: &[[[f32; 3]; 3]]) -> Vec<u8> {
+        let mut bytes = [0u8; 80].to_vec();
+        bytes[..header.len()].copy_from_slice(header);
+        bytes.extend((triangles.len() as u32).to_le_bytes());
+        for t in triangles {
+            bytes.extend([0.0f32, 0.0, 1.0].iter().flat_map(|v| v.to_le_bytes()));
+            bytes.extend(t.iter().flatten().flat_map(|v| v.to_le_bytes()));
+            bytes.extend([0u8, 0]);
+        }
+        bytes
+    }
+
+    const SQUARE: [[f32; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+
+    #[test]
+    fn obj_forms_negative_indices_and_quads() {
+        let text = "# a square and a triangle\r\nmtllib box.mtl\no square\nv 0 0 0\nv 1 0 0\nv 1 1 0 1.0\n\
+            v 0 1 0 0.5 0.5 0.5\nvn 0 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\ng side\nusemtl red\ns off\n\
+            f 1/1/1 2/2/1 3/3/1 4/4/1\nf 1//1 2//1 3//1\nf 1/1 2/2 3/3\n  f -4 -3 -2\nl 1 2\n";
+        let mesh = parse_obj(text.as_bytes()).unwrap();
+        assert_eq!(mesh.vertices, SQUARE.to_vec());
+        assert_eq!(
+            mesh.triangles,
+            vec![[0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 1, 2], [0, 1, 2]]
+        );
+        assert_eq!(mesh.degenerate_count(), 0);
+    }
+
+    #[test]
+    fn obj_malformed() {
+        let two = "v 0 0 0\nv 1 0 0\n";
+        let m = message(parse_obj(format!("{two}f 1 2 3\n").as_bytes()));
+        assert_eq!(m, "line 3: vertex index 3 out of range (2 vertices defined above)");
+        assert!(message(parse_obj(format!("{two}f 0 1 2\n").as_bytes())).contains("vertex index 0 out of range"));
+        assert!(message(parse_obj(format!("{two}f -3 1 2\n").as_bytes())).contains("vertex index -3 out of range"));
+        assert!(message(parse_obj(format!("{two}f 1 2\n").as_bytes())).contains("a face of 2 vertices"));
+        assert!(
+            message(parse_obj(format!("{two}f 1 x 2\n").as_bytes())).contains("expected a vertex index, found \"x\"")
+        );
+        assert_eq!(message(parse_obj(b"v 0 0\n")), "line 1: a vertex needs x y z");
+        assert_eq!(
+            message(parse_obj(b"v 0 0 inf\n")),
+            "line 1: coordinate inf is not a finite f32"
+        );
+        assert!(message(parse_obj(b"v 0 0 1e39\n")).contains("not a finite f32"));
+    }
+
+    #[test]
+    fn stl_ascii_and_binary() {
+        let text = "solid square\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n\
+            vertex 1 1 0\n    endloop\n  endfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\n\
+            vertex 0 1 0\nendloop\nendfacet\nendsolid square\n";
+        let ascii = parse_stl(text.as_bytes()).unwrap();
+        assert_eq!(ascii.triangles, vec![[0, 1, 2], [3, 4, 5]]);
+        assert_eq!(
+            ascii.vertices,
+            vec![SQUARE[0], SQUARE[1], SQUARE[2], SQUARE[0], SQUARE[2], SQUARE[3]]
+        );
+
+        let triangles = [[SQUARE[0], SQUARE[1], SQUARE[2]], [SQUARE[0], SQUARE[2], SQUARE[3]]];
+        assert_eq!(parse_stl(&binary(b"made by hand", &triangles)).unwrap(), ascii);
+        // Many exporters begin a binary header with "solid": the size decides.
+        assert_eq!(
+            parse_stl(&binary(b"solid exported by a CAD tool", &triangles)).unwrap(),
+            ascii
+        );
+        assert_eq!(parse_stl(&binary(b"", &[])).unwrap(), TriangleMesh::default());
+    }
+
+    #[test]
+    fn stl_malformed() {
+        let t = [[SQUARE[0], SQUARE[1], SQUARE[2]]];
+        let mut truncated = binary(b"", &t);
+        truncated.pop();
+        assert_eq!(
+            message(parse_stl(&truncated)),
+            "byte 80: binary STL: the header claims 1 triangles (134 bytes), the file has 133 bytes"
+        );
+        let mut nan = binary(b"", &t);
+        nan[84 + 12 + 4..84 + 12 + 8].copy_from_slice(&f32::NAN.to_le_bytes());
+        assert_eq!(
+            message(parse_stl(&nan)),
+            "byte 100: triangle 0: coordinate NaN is not a finite f32"
+        );
+        assert!(message(parse_stl(b"abc")).contains("not an STL file (3 bytes)"));
+        let open =
+            "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\nendfacet\n";
+        assert_eq!(
+            message(parse_stl(open.as_bytes())),
+            "line 9: the file ends inside a solid (no endsolid)"
+        );
+        let two = "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\nendsolid\n";
+        assert_eq!(
+            message(parse_stl(two.as_bytes())),
+            "line 7: a facet with 2 vertices (3)"
+        );
+        let nan = "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 nan\n";
+        assert!(message(parse_stl(nan.as_bytes())).starts_with("line 4: coordinate NaN"));
+        assert!(message(parse_stl(b"solid x\nvertex 0 0 0\n")).contains("line 2: unexpected \"vertex\""));
+    }
+
+    #[test]
+    fn ply_meshes() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+            property uchar red\nelement face 2\nproperty list uchar int vertex_indices\nproperty uchar flags\n\
+            end_header\n0 0 0 1\n1 0 0 2\n1 1 0 3\n0 1 0 4\n4 0 1 2 3 9\n3 0 0 1 9\n";
+        let mesh = parse_ply_mesh(text.as_bytes()).unwrap();
+        assert_eq!(mesh.vertices, SQUARE.to_vec());
+        assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 0, 1]]);
+        assert_eq!(mesh.degenerate_count(), 1);
+
+        // Binary, doubles, `vertex_index` with uint8 length and uint32 items.
+        let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\n\
+            property double y\nproperty double z\nelement face 1\nproperty list uint8 uint32 vertex_index\nend_header\n"
+            .to_vec();
+        bytes.extend(SQUARE[..3].iter().flatten().flat_map(|&v| f64::from(v).to_le_bytes()));
+        bytes.push(3);
+        bytes.extend([0u32, 1, 2].iter().flat_map(|v| v.to_le_bytes()));
+        let mesh = parse_ply_mesh(&bytes).unwrap();
+        assert_eq!((mesh.vertices, mesh.triangles), (SQUARE[..3].to_vec(), vec![[0, 1, 2]]));
+
+        let out = text.replace("3 0 0 1 9", "3 0 0 4 9");
+        let m = message(parse_ply_mesh(out.as_bytes()));
+        assert_eq!(
+            m,
+            "line 17: element \"face\" row 1 property \"vertex_indices\": vertex index 4 out of range (4 vertices)"
+        );
+        let short = text.replace("3 0 0 1 9", "2 0 1 9");
+        assert!(message(parse_ply_mesh(short.as_bytes())).contains("a face of 2 vertices"));
+        let no_faces = "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+        assert_eq!(message(parse_ply_mesh(no_faces.as_bytes())), "no \"face\" element");
+        let mut cut = bytes.clone();
+        cut.truncate(bytes.len() - 2);
+        assert!(message(parse_ply_mesh(&cut)).contains("the file ends early"));
+    }
+
+    #[test]
+    fn files_by_extension() {
+        let dir = std::env::temp_dir().join(format!("edmp-mesh-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let obj = dir.join("m.OBJ");
+        std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert_eq!(read_mesh(&obj).unwrap().triangles, vec![[0, 1, 2]]);
+        let stl = dir.join("m.stl");
+        std::fs::write(&stl, "solid\nfacet\n").unwrap();
+        assert_eq!(
+            message(read_mesh(&stl)),
+            format!("{}: line 3: the file ends inside a solid (no endsolid)", stl.display())
+        );
+        let dae = dir.join("m.dae");
+        std::fs::write(&dae, "<COLLADA/>").unwrap();
+        assert!(message(read_mesh(&dae)).ends_with("unknown mesh extension \"dae\" (obj, stl or ply)"));
+        assert!(message(read_mesh(&dir.join("none"))).contains("unknown mesh extension \"\""));
+        assert!(message(read_mesh(&dir.join("gone.stl"))).contains("gone.stl: cannot read: "));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -127,13 +127,14 @@ impl Body<'_> {
     /// Moves past whitespace (ASCII), so that [`Body::at`] names the next value's line.
     fn skip(&mut self) {
         if let Body::Ascii { bytes, pos, line } = self {
+            let mut newlines = 0;
             while let Some(&b) = bytes.get(*pos) {
                 if !b.is_ascii_whitespace() {
+                    // At the end of the file, errors keep naming the last line with a value.
+                    *line += newlines;
                     break;
                 }
-                if b == b'\n' {
-                    *line += 1;
-                }
+                newlines += usize::from(b == b'\n');
                 *pos += 1;
             }
         }
