@@ -12,4 +12,6 @@ pub mod mesh_file;
 pub mod moveit;
 pub mod plan;
 mod ply;
+#[cfg(test)]
+mod robustness;
 pub mod trajectory;
