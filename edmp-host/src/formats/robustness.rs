@@ -73,9 +73,10 @@ const WORDS: &[&[u8]] = &[
 /// One mutation of `data`: flip, set, insert or delete bytes, splice a word, cut, or repeat.
 fn mutate(rng: &mut Rng, data: &mut Vec<u8>) {
     let at = rng.below(data.len() + 1);
+    let last = at.min(data.len().saturating_sub(1));
     match rng.below(8) {
-        0 if !data.is_empty() => data[at.min(data.len() - 1)] ^= 1 << rng.below(8),
-        1 if !data.is_empty() => data[at.min(data.len() - 1)] = [0, 0xff, 0x7f, 0x80, b'\n', b' '][rng.below(6)],
+        0 if !data.is_empty() => data[last] ^= 1 << rng.below(8),
+        1 if !data.is_empty() => data[last] = [0, 0xff, 0x7f, 0x80, b'\n', b' '][rng.below(6)],
         2 => data.insert(at, rng.next() as u8),
         3 if at < data.len() => {
             let end = (at + 1 + rng.below(8)).min(data.len());
