@@ -60,7 +60,7 @@ impl fmt::Display for FileError {
     }
 }
 
-impl std::error::Error for FileError {}
+impl core::error::Error for FileError {}
 
 /// Reads a whole file, or says why it cannot.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, FileError> {

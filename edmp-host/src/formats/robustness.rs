@@ -7,7 +7,11 @@
 use super::cloud::{parse_pcd, parse_ply_points};
 use super::file_error::FileError;
 use super::mesh_file::{TriangleMesh, parse_obj, parse_ply_mesh, parse_stl};
-use std::time::{Duration, Instant};
+use core::time::Duration;
+use std::time::Instant;
+
+/// One reader with its checks.
+type Target = fn(&[u8]);
 
 /// A small xorshift generator: reproducible, no dependency.
 struct Rng(u64);
@@ -120,7 +124,7 @@ fn check_mesh(result: Result<TriangleMesh, FileError>) {
 }
 
 /// Runs `target` over random and mutated seeds until the time is up; returns the executions.
-fn run(name: &str, seconds: u64, target: fn(&[u8])) -> u64 {
+fn run(name: &str, seconds: u64, target: Target) -> u64 {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../fuzz/seeds")
         .join(name);
@@ -156,7 +160,7 @@ fn readers_survive_random_and_mutated_bytes() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(60);
-    let targets: [(&str, fn(&[u8])); 4] = [
+    let targets: [(&str, Target); 4] = [
         ("ply", |d| {
             check_points(parse_ply_points(d));
             check_mesh(parse_ply_mesh(d));
