@@ -25,12 +25,14 @@ pub struct TriangleMesh {
 
 impl TriangleMesh {
     /// How many triangles have a repeated vertex index or zero area (kept, for the caller to
-    /// skip or report).
+    /// skip or report). An index out of range (only in a mesh built by hand) counts too.
     pub fn degenerate_count(&self) -> usize {
         self.triangles
             .iter()
             .filter(|t| {
-                let [a, b, c] = t.map(|i| self.vertices[i as usize]);
+                let [Some(&a), Some(&b), Some(&c)] = t.map(|i| self.vertices.get(i as usize)) else {
+                    return true;
+                };
                 let (u, v) = (
                     [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
                     [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
@@ -140,18 +142,25 @@ pub fn parse_stl(bytes: &[u8]) -> Result<TriangleMesh, FileError> {
     {
         return binary_stl(bytes, count);
     }
-    if tokens(bytes.get(..bytes.len().min(256)).unwrap_or(&[])).next() == Some(b"solid") {
-        return ascii_stl(bytes);
-    }
-    match claimed {
-        Some(count) => Err(FileError::new(
+    let size_error = |count: usize| {
+        FileError::new(
             Where::Byte(80),
             format!(
                 "binary STL: the header claims {count} triangles ({} bytes), the file has {} bytes",
                 84 + 50 * count as u64,
                 bytes.len()
             ),
-        )),
+        )
+    };
+    if tokens(bytes.get(..bytes.len().min(256)).unwrap_or(&[])).next() == Some(b"solid") {
+        // A binary file of the wrong size whose header begins with "solid": ASCII has no NUL.
+        return ascii_stl(bytes).map_err(|e| match claimed {
+            Some(count) if bytes.contains(&0) => size_error(count),
+            _ => e,
+        });
+    }
+    match claimed {
+        Some(count) => Err(size_error(count)),
         None => Err(FileError::new(
             Where::File,
             format!("not an STL file ({} bytes)", bytes.len()),
@@ -339,6 +348,11 @@ mod tests {
         assert_eq!(
             message(parse_stl(&truncated)),
             "byte 80: binary STL: the header claims 1 triangles (134 bytes), the file has 133 bytes"
+        );
+        let mut solid = binary(b"solid but binary", &t);
+        solid.truncate(120);
+        assert!(
+            message(parse_stl(&solid)).contains("the header claims 1 triangles (134 bytes), the file has 120 bytes")
         );
         let mut nan = binary(b"", &t);
         nan[84 + 12 + 4..84 + 12 + 8].copy_from_slice(&f32::NAN.to_le_bytes());
