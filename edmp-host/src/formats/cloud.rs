@@ -1,5 +1,5 @@
 //! Point-cloud files for `points` obstacles: PLY (the `vertex` element's `x y z`, through
-//! [`ply`](super::ply)) and PCD (the Point Cloud Library's format, `DATA ascii` or
+//! `ply.rs`) and PCD (the Point Cloud Library's format, `DATA ascii` or
 //! `DATA binary`, fields `x y z`; other properties and fields are dropped). Every coordinate
 //! must be a finite `f32`, so a PCD cloud with NaN "no return" points is refused.
 //!

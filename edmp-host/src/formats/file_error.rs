@@ -1,5 +1,5 @@
 //! The one error of the geometry file readers ([`cloud`](super::cloud),
-//! [`mesh_file`](super::mesh_file), [`ply`](super::ply)): what is wrong, where in the file (a
+//! [`mesh_file`](super::mesh_file), `ply.rs`): what is wrong, where in the file (a
 //! line of a text file, a byte offset of a binary one) and, once read from disk, which file.
 //! The scene reader prefixes the obstacle's path, so a message names obstacle, file and place.
 //! Also the small text helpers the text formats share (lines, tokens, numbers).

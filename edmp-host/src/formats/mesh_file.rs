@@ -1,7 +1,7 @@
 //! Triangle-mesh files for `mesh` obstacles: Wavefront OBJ (`v` and `f`; faces fan-triangulated,
 //! negative indices counted back from the last vertex; normals, texture coordinates, groups and
 //! materials ignored), STL (ASCII or binary, told apart by the binary size rule, so a binary
-//! file whose header begins with `solid` reads as binary) and PLY (through [`ply`](super::ply)).
+//! file whose header begins with `solid` reads as binary) and PLY (through `ply.rs`).
 //!
 //! Written here rather than with `tobj` or `stl_io`: `tobj`'s errors carry no line number and
 //! it resolves material files; `stl_io` iterates as many triangles as a binary header claims
