@@ -579,7 +579,7 @@ fn check_between_own_ends<const N: usize>(
 /// (the problem's start and goal): what a search over the checker asks of each edge.
 ///
 /// The same states as [`check_trajectory`] on `[a, b]`, in another order: `b` first, then
-/// every [`COARSE_STRIDE`]-th state from `a` on, then the rest. A search's `a` is a node
+/// every `COARSE_STRIDE`-th state from `a` on, then the rest. A search's `a` is a node
 /// already known free and its `b` the new step, so an edge that collides mostly does so at
 /// `b`, which one state then proves; a shortcut between two free waypoints collides somewhere
 /// inside, which the coarse pass finds in an eighth of the states.

@@ -1,7 +1,7 @@
 //! Inverse kinematics: a TCP pose to joints within the soft limits, collision-free, closest to
 //! a given configuration.
 //!
-//! Damped least squares on the TCP Jacobian ([`Kinematics::tcp_jacobian`]) from a fixed list
+//! Damped least squares on the TCP Jacobian ([`Kinematics::tcp_jacobian`](crate::robot::kinematics::Kinematics::tcp_jacobian)) from a fixed list
 //! of starts: the preferred configuration first, then a Halton sequence over the soft limits,
 //! so the answer is deterministic and the work is bounded (`starts × iterations` FK and 6×6
 //! solves at most). Each iterate is projected back into the limits; a converged solution is

@@ -7,7 +7,7 @@
 //!    falls back to the polyline (what the planner checked) when the spline touches anything.
 //! 3. **Time-optimal profile** ([`topp`]): TOPP-RA-style reachability on a grid over the
 //!    parameter, velocity and acceleration limits.
-//! 4. **Jerk** ([`profile`]): a moving average of the profile over a window `w` bounds its
+//! 4. **Jerk** (`profile.rs`): a moving average of the profile over a window `w` bounds its
 //!    jerk; a final uniform time scaling `k ≥ 1`, measured on samples of every piece and
 //!    verified on other samples (with an analytic bound as the guaranteed last resort), makes
 //!    every limit hold.
