@@ -1,3 +1,7 @@
+//! The planner's unit tests. Compiled only for `cargo test` (`#[cfg(test)] mod tests;` in
+//! `planner/mod.rs`), never into the library: the `unwrap`s here are test assertions on fixed
+//! inputs, not panic paths of the planner.
+
 use super::judge::clamp_for_judging;
 use super::refine::refine;
 use super::waves::{permute, wave_order};

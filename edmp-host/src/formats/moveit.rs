@@ -852,19 +852,18 @@ fn tcp_offset(link: &str, path: &str) -> R<Isometry3<f64>> {
     Ok(iso(&k.frames[frame]).inverse() * iso(&k.frames[TCP_FRAME]))
 }
 
+/// The fields of `moveit_msgs/Constraints` (a goal, or the path constraints).
+const CONSTRAINTS: [&str; 5] = [
+    "name",
+    "joint_constraints",
+    "position_constraints",
+    "orientation_constraints",
+    "visibility_constraints",
+];
+
 /// The goal of `moveit_msgs/Constraints`: joints (and finger openings), or the TCP pose.
 fn goal(v: &Value, path: &str, frames: &Frames) -> R<(Value, Fingers)> {
-    let map = mapping(
-        v,
-        path,
-        &[
-            "name",
-            "joint_constraints",
-            "position_constraints",
-            "orientation_constraints",
-            "visibility_constraints",
-        ],
-    )?;
+    let map = mapping(v, path, &CONSTRAINTS)?;
     unsupported_if_any(map, path, "visibility_constraints", "visibility constraints")?;
     let (jc, jcp) = sequence(map, path, "joint_constraints")?;
     let (pc, pcp) = sequence(map, path, "position_constraints")?;
@@ -1091,17 +1090,7 @@ fn request_start(v: &Value) -> R<State> {
         ));
     }
     if let Some(pc) = map.and_then(|m| m.get("path_constraints")) {
-        let pm = mapping(
-            pc,
-            "path_constraints",
-            &[
-                "name",
-                "joint_constraints",
-                "position_constraints",
-                "orientation_constraints",
-                "visibility_constraints",
-            ],
-        )?;
+        let pm = mapping(pc, "path_constraints", &CONSTRAINTS)?;
         for key in [
             "joint_constraints",
             "position_constraints",
