@@ -4,7 +4,7 @@
 //! Everything the page draws is computed here and embedded as JSON: the arm's visual meshes
 //! (the URDF's `<visual>` meshes with their origins), the obstacles, and for every sample of
 //! the animation the world pose of each link frame from the core's forward kinematics. The
-//! page's JavaScript (`view.js`, on the vendored three.js in `vendor/three`) only places meshes
+//! page's JavaScript (`page.js`, on the vendored three.js in `vendor/three`) only places meshes
 //! at those poses and interpolates between samples; it computes no kinematics.
 
 use crate::Failure;
@@ -167,7 +167,7 @@ fn fill(template: &str, parts: &[(&str, &str)]) -> Result<String, String> {
     for (key, text) in parts {
         let (before, after) = rest
             .split_once(key)
-            .ok_or_else(|| format!("view.html: no {key} (or out of order)"))?;
+            .ok_or_else(|| format!("page.html: no {key} (or out of order)"))?;
         out.push_str(before);
         out.push_str(text);
         rest = after;
@@ -237,7 +237,7 @@ fn timeline(problem: &Problem, plan: Option<&PlanDocument>) -> Vec<(f32, Joints<
 }
 
 /// A primitive as the page draws it: its kind, sizes and pose. New kinds of obstacle get a
-/// case here and a drawing function in `view.js`'s `SHAPES`.
+/// case here and a drawing function in `page.js`'s `SHAPES`.
 fn primitive(o: &Obstacle) -> Value {
     let pose = json!({"position": micro3(&o.center), "quaternion": quaternion(&o.rotation)});
     let mut out = match o.shape {
