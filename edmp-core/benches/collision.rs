@@ -31,7 +31,7 @@ fn trajectory(rng: &mut Rng) -> [[f32; 7]; H] {
 }
 
 /// 20 obstacles around the arm, none touching `path` (so the checker walks every state).
-fn scene(rng: &mut Rng, path: &[[f32; 7]; H]) -> Scene<64> {
+fn scene(rng: &mut Rng, path: &[[f32; 7]; H]) -> Scene<'static, 64> {
     let mut scene = Scene::<64>::new();
     scene
         .push(Obstacle::cuboid([0.5, 0.0, -0.02], [1.0, 1.2, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())

@@ -31,6 +31,7 @@ pub mod prior;
 pub mod rng;
 pub mod robot;
 pub mod scene;
+pub mod surface;
 pub mod trajectory;
 #[cfg(feature = "serde")]
 pub mod wire;

@@ -4,6 +4,7 @@
 //! the checker never see a NaN, a zero size or a non-rotation.
 
 use crate::robot::{FINGER_OPENING_DEFAULT, FINGER_OPENING_MAX, FINGER_OPENING_MIN};
+use crate::surface::{Surface, cover};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// Default obstacle capacity of a [`Scene`].
@@ -160,6 +161,13 @@ pub fn rotation_from_wxyz(q: [f32; 4]) -> Result<Matrix3<f32>, SceneError> {
 }
 
 impl Obstacle {
+    /// A unit ball at the origin: fills fixed arrays before they are written.
+    pub const PLACEHOLDER: Self = Self {
+        shape: Shape::Sphere { radius: 1.0 },
+        center: Vector3::new(0.0, 0.0, 0.0),
+        rotation: Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+    };
+
     /// A cuboid with full extents `dims`, rotated by the quaternion `[w, x, y, z]`.
     pub fn cuboid(center: [f32; 3], dims: [f32; 3], quaternion: [f32; 4]) -> Result<Self, SceneError> {
         finite(&center)?;
@@ -196,16 +204,21 @@ impl Obstacle {
     }
 }
 
-/// Obstacles (at most `N`), an optional object held in the hand (pose in the `panda_hand`
-/// frame) and the opening of each finger (default `robot::FINGER_OPENING_DEFAULT`, 0.025 m).
+/// Obstacles (at most `N`), the pieces of clouds and meshes ([`Surface`], borrowed from the
+/// caller's buffers, with a few boxes around them for the guides among the `N`), an optional
+/// object held in the hand (pose in the `panda_hand` frame) and the opening of each finger
+/// (default `robot::FINGER_OPENING_DEFAULT`, 0.025 m).
 #[derive(Clone, Debug)]
-pub struct Scene<const N: usize = MAX_OBSTACLES> {
+pub struct Scene<'a, const N: usize = MAX_OBSTACLES> {
+    /// The primitives first (`primitives` of them), then the surface's boxes for the guides.
     obstacles: heapless::Vec<Obstacle, N>,
+    primitives: usize,
+    surface: Surface<'a>,
     held: Option<Obstacle>,
     finger: f32,
 }
 
-impl<const N: usize> Default for Scene<N> {
+impl<const N: usize> Default for Scene<'_, N> {
     fn default() -> Self {
         Self::new()
     }
@@ -221,11 +234,13 @@ pub fn finger_opening(finger: f32) -> Result<f32, SceneError> {
     }
 }
 
-impl<const N: usize> Scene<N> {
+impl<'a, const N: usize> Scene<'a, N> {
     /// An empty scene, the fingers at the default opening.
     pub const fn new() -> Self {
         Self {
             obstacles: heapless::Vec::new(),
+            primitives: 0,
+            surface: Surface::EMPTY,
             held: None,
             finger: FINGER_OPENING_DEFAULT,
         }
@@ -251,9 +266,42 @@ impl<const N: usize> Scene<N> {
         self.finger
     }
 
-    /// Adds an obstacle (already validated by its constructor).
+    /// Adds an obstacle (already validated by its constructor), before any surface boxes.
     pub fn push(&mut self, obstacle: Obstacle) -> Result<(), SceneError> {
-        self.obstacles.push(obstacle).map_err(|_| SceneError::TooManyObstacles)
+        self.obstacles
+            .push(obstacle)
+            .map_err(|_| SceneError::TooManyObstacles)?;
+        // Moved down past the surface's boxes, one swap at a time (no panicking insert).
+        let mut i = self.obstacles.len().saturating_sub(1);
+        while i > self.primitives {
+            if let Some([a, b]) = self.obstacles.get_mut(i - 1..i + 1) {
+                core::mem::swap(a, b);
+            }
+            i -= 1;
+        }
+        self.primitives += 1;
+        Ok(())
+    }
+
+    /// This scene with `surface`'s pieces as obstacles: the checker takes them exactly, the
+    /// guides through up to `boxes` boxes around them ([`cover::covers`]), fewer when the
+    /// scene's capacity runs out first. Any earlier surface and its boxes are replaced.
+    pub fn with_surface<'b>(self, surface: Surface<'b>, boxes: usize) -> Scene<'b, N> {
+        let mut obstacles = self.obstacles;
+        obstacles.truncate(self.primitives);
+        let mut out = [Obstacle::PLACEHOLDER; cover::MAX_COVERS];
+        let room = N.saturating_sub(self.primitives).min(boxes).min(cover::MAX_COVERS);
+        let made = cover::covers(&surface, out.get_mut(..room).unwrap_or(&mut []));
+        for b in out.iter().take(made) {
+            let _ = obstacles.push(*b);
+        }
+        Scene {
+            obstacles,
+            primitives: self.primitives,
+            surface,
+            held: self.held,
+            finger: self.finger,
+        }
     }
 
     /// Attaches `object` to the hand (its pose is in the `panda_hand` frame), replacing any other.
@@ -261,9 +309,19 @@ impl<const N: usize> Scene<N> {
         self.held = Some(object);
     }
 
-    /// The obstacles.
+    /// The primitive obstacles: what the checker tests besides the surface.
     pub fn obstacles(&self) -> &[Obstacle] {
+        self.obstacles.get(..self.primitives).unwrap_or(&[])
+    }
+
+    /// What the guides' costs see: the primitives and the boxes around the surface.
+    pub fn guide_obstacles(&self) -> &[Obstacle] {
         &self.obstacles
+    }
+
+    /// The pieces of the scene's clouds and meshes.
+    pub fn surface(&self) -> &Surface<'a> {
+        &self.surface
     }
 
     /// The held object, if any.

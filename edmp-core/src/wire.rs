@@ -31,7 +31,7 @@ pub struct Problem<const N: usize = MAX_OBSTACLES> {
 
 impl<const N: usize> Problem<N> {
     /// The scene, every primitive validated on the way in.
-    pub fn to_scene(&self) -> Result<Scene<N>, SceneError> {
+    pub fn to_scene(&self) -> Result<Scene<'static, N>, SceneError> {
         let mut scene = Scene::new();
         for primitive in &self.obstacles {
             scene.push(primitive.to_obstacle()?)?;

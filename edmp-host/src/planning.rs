@@ -81,7 +81,7 @@ fn plan_with<E: Executor, const C: usize>(
     let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
     let mut work = Box::new(Workspace::<ROWS, HOST_SEARCH_NODES>::new());
     let req = Request {
-        scene: &problem.scene,
+        scene: &problem.scene(),
         start: &problem.start,
         goal: &goal,
         guides,

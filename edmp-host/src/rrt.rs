@@ -119,7 +119,7 @@ fn steer(from: &Joints<f32>, to: &Joints<f32>, step: f32) -> Joints<f32> {
 }
 
 struct Planner<'a, const N: usize> {
-    scene: &'a Scene<N>,
+    scene: &'a Scene<'a, N>,
     check: CheckConfig,
     /// The problem's start and goal: states near them keep the checker's end margin.
     ends: [Joints<f32>; 2],
@@ -299,7 +299,7 @@ mod tests {
     use super::*;
     use edmp_core::scene::Obstacle;
 
-    fn wall_scene() -> Scene<8> {
+    fn wall_scene() -> Scene<'static, 8> {
         let mut scene = Scene::<8>::new();
         // A wall in front of the robot, between a left and a right reach.
         scene

@@ -253,7 +253,7 @@ fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
 
 /// The scene of an `edmp-scene/1` document, rebuilt here from the JSON with the core's
 /// constructors (independent of the host's parser).
-fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene {
+fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene<'static> {
     use edmp_core::scene::{Obstacle, Scene};
     let v3 = |v: &serde_json::Value| -> [f32; 3] { core::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
     let v4 = |v: &serde_json::Value| -> [f32; 4] { core::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };

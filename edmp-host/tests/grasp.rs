@@ -84,7 +84,7 @@ fn the_opening_travels_in_the_firmwares_postcard_bytes() {
         scene.obstacles(),
         edmp_host::formats::json::parse_problem(&text)
             .unwrap()
-            .scene
+            .scene()
             .obstacles()
     );
     // A scene without the field travels at the default opening.

@@ -104,7 +104,7 @@ fn the_table_scene_with_a_joint_goal_is_the_wall_example() {
     let planned = plan_problem(&problem, &guides, &PlanConfig::DEFAULT, 0).unwrap();
     assert!(planned.plan.is_free());
     let report = check_trajectory(
-        &problem.scene,
+        &problem.scene(),
         &planned.plan.paths[planned.plan.best],
         &CheckConfig::default(),
         false,
@@ -531,7 +531,7 @@ fn open_fingers_become_the_gripper_field() {
     let scene = file("table_box.scene.yaml").replace("    - 0.025\n    - 0.025\n", "    - 0.035\n    - 0.035\n");
     let (doc, problem) = import_validated(&scene, Some(&file("pose_goal.request.yaml"))).unwrap();
     assert_eq!(doc["gripper"], json!({"finger": 0.035}));
-    assert_eq!(problem.scene.gripper(), 0.035);
+    assert_eq!(problem.scene().gripper(), 0.035);
     let (doc, _) = import_validated(&file("table_box.scene.yaml"), None).unwrap();
     assert!(doc.get("gripper").is_none(), "0.025 m is the format's default");
 }
@@ -732,7 +732,7 @@ fn every_example_round_trips_through_moveit_yaml_and_plans_the_same() {
             "{name}: the imported scene plans differently"
         );
         let report = check_trajectory(
-            &problem.scene,
+            &problem.scene(),
             &got.plan.paths[got.plan.best],
             &CheckConfig::default(),
             false,

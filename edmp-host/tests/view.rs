@@ -281,7 +281,7 @@ fn chromium_draws_the_arm_where_the_kinematics_put_it() {
         plan.trajectory.is_empty(),
         "untimed: the waypoints are played {EVEN_STEP_S} s apart"
     );
-    let finger = problem.scene.gripper();
+    let finger = problem.scene().gripper();
     let fk_tcp = |i: usize| {
         forward_with(&plan.waypoints[i], finger)
             .unwrap()

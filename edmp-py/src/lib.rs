@@ -5,13 +5,13 @@
 //! its planner driver and its one writer of `edmp-plan/1` (`edmp_host::commands::plan`), so a plan
 //! from Python is the CLI's document. Planning releases the GIL.
 
-use edmp_core::collision::checker::{CheckConfig, Contact, check_trajectory};
+use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::path::HORIZON;
 use edmp_core::planner::{Judging, PlanConfig};
-use edmp_core::robot::{BODY_NAMES, JOINT_NAMES, JOINTS};
+use edmp_core::robot::{JOINT_NAMES, JOINTS};
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;
-use edmp_host::formats::json::{Goal, Problem, joint_goal, parse_problem};
+use edmp_host::formats::json::{Goal, Problem, describe, joint_goal, parse_problem};
 use edmp_host::formats::plan::{add_trajectory, parse_plan, plan_document};
 use edmp_host::formats::trajectory::TimedRequest;
 use edmp_host::planning::{chosen_guides, plan_problem};
@@ -158,14 +158,6 @@ fn fk(q: Vec<f64>) -> PyResult<String> {
     to_json(&doc)
 }
 
-fn describe(contact: Contact) -> String {
-    let body = |b: u8| BODY_NAMES.get(usize::from(b)).copied().unwrap_or("held_object");
-    match contact {
-        Contact::Obstacle { body: b, obstacle } => format!("{} touches obstacles[{obstacle}]", body(b)),
-        Contact::SelfContact { first, second } => format!("{} touches {}", body(first), body(second)),
-    }
-}
-
 /// The exact checker (`checker::check_trajectory`, every contact counted) on `HORIZON`
 /// waypoints in the scene: a JSON report.
 #[pyfunction]
@@ -181,11 +173,11 @@ fn check(scene: &str, waypoints: Vec<Vec<f64>>) -> PyResult<String> {
     for (i, (slot, row)) in path.iter_mut().zip(&waypoints).enumerate() {
         *slot = joints_of(row, &format!("waypoints[{i}]"))?;
     }
-    let report = check_trajectory(&problem.scene, &path, &CheckConfig::default(), false)
+    let report = check_trajectory(&problem.scene(), &path, &CheckConfig::default(), false)
         .map_err(|e| PlanError::new_err(format!("checker: {e}")))?;
-    let first = report
-        .first_contact
-        .map(|c| json!({"segment": c.segment, "step": c.step, "contact": describe(c.contact)}));
+    let first = report.first_contact.map(
+        |c| json!({"segment": c.segment, "step": c.step, "contact": describe(c.contact, &problem.primitive_index)}),
+    );
     to_json(&json!({
         "free": report.is_free(),
         "states": report.states,
@@ -210,12 +202,10 @@ fn ik(scene: &str, position: Vec<f64>, quaternion: Vec<f64>) -> PyResult<Option<
     if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
         return Err(PyValueError::new_err(format!("quaternion: norm {norm:.2}, expected 1")));
     }
-    let posed = Problem {
-        goal: Goal::Pose {
-            position: [p[0], p[1], p[2]],
-            quaternion: [q[0], q[1], q[2], q[3]],
-        },
-        ..problem
+    let mut posed = problem;
+    posed.goal = Goal::Pose {
+        position: [p[0], p[1], p[2]],
+        quaternion: [q[0], q[1], q[2], q[3]],
     };
     Ok(joint_goal(&posed).ok().map(|j| j.to_vec()))
 }

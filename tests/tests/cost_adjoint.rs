@@ -21,7 +21,7 @@ const H: usize = 6;
 #[derive(Clone, Debug)]
 struct Case {
     trajectory: [[f32; JOINTS]; H],
-    scene: Scene<16>,
+    scene: Scene<'static, 16>,
     config: CostConfig,
 }
 

@@ -11,7 +11,7 @@ use edmp_core::scene::{Obstacle, Scene};
 
 const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
 
-fn wall_scene() -> Scene<8> {
+fn wall_scene() -> Scene<'static, 8> {
     let mut scene = Scene::<8>::new();
     scene
         .push(Obstacle::cuboid([0.5, 0.0, -0.01], [1.2, 1.6, 0.02], ID).unwrap())

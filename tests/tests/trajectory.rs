@@ -441,7 +441,7 @@ fn the_same_input_gives_the_same_bits() {
     );
 }
 
-fn ball_scene(center: [f32; 3], radius: f32) -> Scene<4> {
+fn ball_scene(center: [f32; 3], radius: f32) -> Scene<'static, 4> {
     let mut scene = Scene::<4>::new();
     scene.push(Obstacle::sphere(center, radius).unwrap()).unwrap();
     scene

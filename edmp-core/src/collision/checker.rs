@@ -2,7 +2,8 @@
 //!
 //! Geometry is exact, never boxed: each robot body is the convex hull of its collision mesh
 //! (the same hull PyBullet collides), obstacles and the held object are true cuboids,
-//! cylinders and spheres. A pair is declared free only when a GJK separating direction
+//! cylinders and spheres, and the balls and triangles of clouds and meshes
+//! ([`crate::surface`]), found near a body through their hierarchy. A pair is declared free only when a GJK separating direction
 //! *certifies* a gap larger than the margin ([`crate::collision::gjk::apart`]); anything else counts as
 //! contact. Cheap tests run first and can only prove freedom: bounding balls, then the body's
 //! oriented box (which holds its hull).
@@ -12,9 +13,10 @@
 //! neighbours (link7, hand, fingers and held object form one rigid group), at every waypoint
 //! and at every state of the linear joint interpolation in steps of at most `max_step`.
 
-use crate::collision::convex::{Hull, Solid};
+use crate::collision::convex::{Convex, Hull, Solid};
 use crate::collision::gjk::{apart_by, distance_lower_bound};
 use crate::error::Error;
+use crate::float::sqrt_below;
 use crate::robot::kinematics::{Joints, Kinematics, forward_with};
 use crate::robot::reach::{BODY_REACH, HAND_REACH, motion};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
@@ -94,6 +96,13 @@ pub enum Contact {
         body: u8,
         /// Obstacle index in the scene.
         obstacle: u8,
+    },
+    /// Robot body (or [`HELD_BODY`]) `body` against a piece of a cloud or a mesh.
+    Surface {
+        /// Body index.
+        body: u8,
+        /// The piece's obstacle ([`crate::surface::element::Element::obstacle`]).
+        obstacle: u16,
     },
     /// Two robot bodies that are not chain neighbours.
     SelfContact {
@@ -197,7 +206,7 @@ impl Placed<'_> {
 
     /// Body `b` (robot or held) proven apart from primitive `p`: the certified gap (above the
     /// margin), `None` when it is not proven.
-    fn body_apart_from(&self, b: usize, p: &Solid, hint: &mut Vector3<f32>) -> Option<f32> {
+    fn body_apart_from<P: Convex>(&self, b: usize, p: &P, hint: &mut Vector3<f32>) -> Option<f32> {
         if b >= BODIES {
             return match &self.held {
                 Some(h) => apart_by(h, p, self.margin, hint),
@@ -228,6 +237,8 @@ const SLOTS: usize = BODIES + 1;
 /// to the next (zero: none yet).
 struct Hints<const N: usize> {
     obstacle: [[Vector3<f32>; N]; SLOTS],
+    /// Per shape, the direction last found against any piece of the surface.
+    surface: [Vector3<f32>; SLOTS],
     body: [[Vector3<f32>; SLOTS]; SLOTS],
 }
 
@@ -235,6 +246,7 @@ impl<const N: usize> Hints<N> {
     fn new() -> Self {
         Self {
             obstacle: [[Vector3::zeros(); N]; SLOTS],
+            surface: [Vector3::zeros(); SLOTS],
             body: [[Vector3::zeros(); SLOTS]; SLOTS],
         }
     }
@@ -266,19 +278,9 @@ fn relative_motion(a: &[f32; JOINTS], b: &[f32; JOINTS], step: &Joints<f32>) -> 
     m
 }
 
-/// A lower bound on `√x` within 0.1 % of it, without `libm::sqrtf`, whose legacy-SSE `sqrtss`
-/// stalls among the AVX code around it on x86-64-v3 (`perf`: the balls' gaps were a tenth of a
-/// global-stage plan's time): a first guess from the bits, one Newton step (which lands at most
-/// 0.096 % above `√x`, never below but for rounding), then 0.1 % off. 0 where `x` is tiny or
-/// not finite (always a lower bound).
-fn sqrt_below(x: f32) -> f32 {
-    if !x.is_finite() || x < 1e-30 {
-        return 0.0;
-    }
-    let guess = f32::from_bits((x.to_bits() >> 1) + 0x1fbd_1df5);
-    let newton = 0.5 * (guess + x / guess);
-    newton * 0.999
-}
+/// How far the surface's pieces are looked for around a body: nearer pieces are each proven
+/// clear, and the nearest one's gap (at most this) is carried to the next states.
+const SURFACE_HORIZON: f32 = 0.05;
 
 /// What a certified gap leaves for the states after it, below the gap less the margin: room for
 /// the kinematics' f32 rounding (metres).
@@ -290,6 +292,8 @@ const CARRY_SLACK: f32 = 1e-4;
 /// whose pairs have slack left needs no kinematics.
 struct Slack<const N: usize> {
     obstacle: [[f32; N]; SLOTS],
+    /// Per shape, against the whole surface (its nearest piece).
+    surface: [f32; SLOTS],
     body: [[f32; SLOTS]; SLOTS],
     /// The state the slack was last used up to; `None`: nothing carried yet.
     at: Option<Joints<f32>>,
@@ -299,6 +303,7 @@ impl<const N: usize> Slack<N> {
     fn new() -> Self {
         Self {
             obstacle: [[0.0; N]; SLOTS],
+            surface: [0.0; SLOTS],
             body: [[0.0; SLOTS]; SLOTS],
             at: None,
         }
@@ -309,7 +314,7 @@ impl<const N: usize> Slack<N> {
 /// the robot shapes' ball radii, the self-collision pairs, and the separating directions
 /// remembered so far.
 struct Prepared<'s, const N: usize> {
-    scene: &'s Scene<N>,
+    scene: &'s Scene<'s, N>,
     config: CheckConfig,
     obstacles: [Solid; N],
     obstacle_radius: [f32; N],
@@ -324,7 +329,7 @@ struct Prepared<'s, const N: usize> {
 }
 
 impl<'s, const N: usize> Prepared<'s, N> {
-    fn new(scene: &'s Scene<N>, config: &CheckConfig) -> Result<Self, Error> {
+    fn new(scene: &'s Scene<'s, N>, config: &CheckConfig) -> Result<Self, Error> {
         validate(config)?;
         let obstacles: [Solid; N] =
             core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Solid::obstacle));
@@ -380,6 +385,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
     /// gap the motion since (bounded by [`crate::robot::reach`]) cannot have used up.
     fn contact_at(&mut self, q: &Joints<f32>, margin: f32) -> Result<Option<Contact>, Error> {
         let count = self.scene.obstacles().len();
+        let surface = *self.scene.surface();
         let step: Joints<f32> = match &self.slack.at {
             Some(last) => core::array::from_fn(|j| (q[j] - last[j]).abs()),
             // Nothing carried: every slack is still 0, so every pair is tested.
@@ -392,6 +398,11 @@ impl<'s, const N: usize> Prepared<'s, N> {
         let mut untested = false;
         for b in (0..self.shapes).filter(|&b| moves(b)) {
             for s in self.slack.obstacle[b % SLOTS].iter_mut().take(count) {
+                *s -= moved[b % SLOTS];
+                untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
+            }
+            if !surface.is_empty() {
+                let s = &mut self.slack.surface[b % SLOTS];
                 *s -= moved[b % SLOTS];
                 untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
             }
@@ -455,6 +466,26 @@ impl<'s, const N: usize> Prepared<'s, N> {
                 };
                 *slack = gap - carry;
             }
+            let slack = &mut self.slack.surface[b % SLOTS];
+            if !surface.is_empty() && *slack <= 0.0 {
+                let hint = &mut self.hints.surface[b % SLOTS];
+                let gap = surface.gap(
+                    &center[b % SLOTS],
+                    self.radius[b % SLOTS],
+                    margin,
+                    SURFACE_HORIZON,
+                    |e| placed.body_apart_from(b, e, hint),
+                );
+                match gap {
+                    Ok(gap) => *slack = gap - carry,
+                    Err(obstacle) => {
+                        return Ok(Some(Contact::Surface {
+                            body: b as u8,
+                            obstacle,
+                        }));
+                    }
+                }
+            }
         }
         if !self.config.self_collision {
             return Ok(None);
@@ -505,7 +536,7 @@ pub fn check_end<const N: usize>(
 }
 
 /// A certified lower bound on the distance from the moving robot bodies' hulls (and the held
-/// object) to the nearest obstacle: zero when something may touch. Obstacles only; for
+/// object) to the nearest obstacle or surface piece: zero when something may touch. Self-contact is not counted; for
 /// diagnostics and for choosing among states that are all free.
 pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f32, Error> {
     let k = forward_with(q, scene.gripper())?;
@@ -522,6 +553,27 @@ pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f3
         if let Some(h) = &held {
             best = best.min(distance_lower_bound(h, &o));
         }
+    }
+    let surface = scene.surface();
+    for b in (0..BODIES).filter(|&b| moves(b)) {
+        let hull = Hull {
+            pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
+            points: PANDA.hull(b),
+        };
+        let (center, radius) = (
+            k.boxes[b].translation,
+            crate::float::sqrt(PANDA.bodies[b].half_extents.norm_squared()),
+        );
+        let gap = surface.gap(&center, radius, f32::INFINITY, best, |e| {
+            Some(distance_lower_bound(&hull, e))
+        });
+        best = best.min(gap.unwrap_or(0.0));
+    }
+    if let Some(h) = &held {
+        let gap = surface.gap(&h.center, h.bounding_radius(), f32::INFINITY, best, |e| {
+            Some(distance_lower_bound(h, e))
+        });
+        best = best.min(gap.unwrap_or(0.0));
     }
     Ok(best)
 }
@@ -724,7 +776,7 @@ mod tests {
 
     /// A thin plate between the fingers (2 cm across the hand's y, 1 cm thick, 2 cm tall, centred
     /// 9.5 cm from the hand on its z, turned with the hand), as one obstacle.
-    fn plate_between_the_fingers() -> Scene<4> {
+    fn plate_between_the_fingers() -> Scene<'static, 4> {
         let k = forward(&READY).unwrap();
         let hand = &k.frames[HAND_FRAME];
         let center = hand.transform_point(&Vector3::new(0.0, 0.0, 0.095));

@@ -57,12 +57,12 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
         }
     }
     let obstacles: [Solid; N] = core::array::from_fn(|i| {
-        scene.obstacles().get(i).map_or(
+        scene.guide_obstacles().get(i).map_or(
             Solid::cuboid(&crate::robot::kinematics::Pose::identity(), &Vector3::zeros()),
             Solid::obstacle,
         )
     });
-    let obstacles = obstacles.get(..scene.obstacles().len()).unwrap_or(&[]);
+    let obstacles = obstacles.get(..scene.guide_obstacles().len()).unwrap_or(&[]);
     let mut reach = [0.0f32; N];
     for (r, o) in reach.iter_mut().zip(obstacles) {
         *r = o.bounding_radius() + clearance;
@@ -254,7 +254,7 @@ mod tests {
     const H: usize = 6;
 
     /// A wall in front of the robot, its face at x = 0.45.
-    fn wall() -> Scene<4> {
+    fn wall() -> Scene<'static, 4> {
         let mut s = Scene::new();
         let o = Obstacle::cuboid([0.6, 0.0, 0.5], [0.3, 1.0, 1.0], [1.0, 0.0, 0.0, 0.0]);
         s.push(o.unwrap()).unwrap();

@@ -419,14 +419,14 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
         bounds: empty,
         world: empty,
     }; N];
-    for (slot, o) in obstacles.iter_mut().zip(scene.obstacles()) {
+    for (slot, o) in obstacles.iter_mut().zip(scene.guide_obstacles()) {
         *slot = ObstacleBox::new(o, config);
         // Finite but huge sizes or inflation can overflow the box (and 0·∞ make it NaN).
         if !slot.is_finite() {
             return Err(Error::Overflow);
         }
     }
-    let obstacles = obstacles.get(..scene.obstacles().len()).unwrap_or(&[]);
+    let obstacles = obstacles.get(..scene.guide_obstacles().len()).unwrap_or(&[]);
     let held = scene
         .held()
         .map(|h| (held_local_pose(h), box_dims(&h.shape, config.cylinder) * 0.5));
@@ -889,7 +889,7 @@ mod tests {
     }
 
     /// One bar across the sweep's path.
-    fn bar() -> Scene<1> {
+    fn bar() -> Scene<'static, 1> {
         let mut scene = Scene::<1>::new();
         scene
             .push(Obstacle::cuboid([0.5, 0.0, 0.4], [0.05, 0.3, 0.05], ID).unwrap())

@@ -366,7 +366,7 @@ mod tests {
     }
 
     /// A box in front of the robot that a sweep of joint 1 passes through.
-    fn scene() -> Scene<4> {
+    fn scene() -> Scene<'static, 4> {
         let mut s = Scene::new();
         let wall = Obstacle::cuboid([0.55, 0.0, 0.45], [0.1, 0.1, 0.3], [1.0, 0.0, 0.0, 0.0]);
         s.push(wall.unwrap()).unwrap();

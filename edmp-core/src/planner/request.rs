@@ -10,7 +10,7 @@ use crate::scene::Scene;
 #[derive(Clone, Copy, Debug)]
 pub struct Request<'a, const N: usize> {
     /// The obstacles, the held object and the gripper opening.
-    pub scene: &'a Scene<N>,
+    pub scene: &'a Scene<'a, N>,
     /// The first waypoint of every candidate.
     pub start: &'a Joints<f32>,
     /// The last waypoint of every candidate.

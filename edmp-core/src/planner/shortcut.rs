@@ -238,7 +238,7 @@ mod tests {
         path
     }
 
-    fn floor() -> Scene<4> {
+    fn floor() -> Scene<'static, 4> {
         let mut s = Scene::new();
         s.push(Obstacle::cuboid([0.5, 0.0, -0.01], [1.2, 1.6, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())
             .unwrap();

@@ -21,7 +21,7 @@ use crate::scene::Obstacle;
 use crate::scene::Scene;
 use std::boxed::Box;
 
-fn wall_scene() -> Scene<4> {
+fn wall_scene() -> Scene<'static, 4> {
     let mut s = Scene::new();
     s.push(Obstacle::cuboid([0.5, 0.0, -0.01], [1.2, 1.6, 0.02], [1.0, 0.0, 0.0, 0.0]).unwrap())
         .unwrap();
@@ -603,7 +603,7 @@ fn waves_take_every_waves_th_guide() {
 }
 
 /// The wall scene with a block through the robot's shoulder: no state is free.
-fn blocked_scene() -> Scene<4> {
+fn blocked_scene() -> Scene<'static, 4> {
     let mut s = wall_scene();
     s.push(Obstacle::cuboid([0.0, 0.0, 0.45], [0.3, 0.3, 0.3], [1.0, 0.0, 0.0, 0.0]).unwrap())
         .unwrap();

@@ -8,7 +8,7 @@
 
 use crate::Failure;
 use crate::commands::plan::Tuning;
-use crate::formats::json::{Goal, parse_problem};
+use crate::formats::json::{Goal, parse_problem_in};
 use crate::metrics::{Roughness, acsm, path_length, roughness};
 use crate::planning::{chosen_guides, plan_problem_on};
 use crate::plots;
@@ -156,8 +156,8 @@ fn label(args: &Args, guides: &[u8]) -> String {
     }
 }
 
-fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
-    let parsed = parse_problem(text).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
+fn run_edmp(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record, Failure> {
+    let parsed = parse_problem_in(text, dir).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
     let guides = args.tuning.guides(&args.guides)?;
     let config = args.tuning.config()?;
     let planned = plan_problem_on(&parsed, &guides, &config, args.seed, args.tuning.threads()?)?;
@@ -215,8 +215,8 @@ fn run_edmp(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
     })
 }
 
-fn run_rrt(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
-    let parsed = parse_problem(text).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
+fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record, Failure> {
+    let parsed = parse_problem_in(text, dir).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
     let goal = match parsed.goal {
         Goal::Joints(q) => q,
         Goal::Pose { .. } => crate::formats::json::joint_goal(&parsed).map_err(Failure::Input)?,
@@ -227,7 +227,7 @@ fn run_rrt(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
     };
     let began = std::time::Instant::now();
     let planned = crate::rrt::plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(
-        &parsed.scene,
+        &parsed.scene(),
         &parsed.start,
         &goal,
         &config,
@@ -236,7 +236,7 @@ fn run_rrt(args: &Args, text: &str, problem: &str) -> Result<Record, Failure> {
     let time_ms = began.elapsed().as_secs_f64() * 1e3;
     let (status, waypoints) = match planned {
         Ok(p) => {
-            let report = check_trajectory(&parsed.scene, &p.waypoints, &CheckConfig::DEFAULT, true)
+            let report = check_trajectory(&parsed.scene(), &p.waypoints, &CheckConfig::DEFAULT, true)
                 .map_err(|e| Failure::Input(format!("{problem}: checker: {e}")))?;
             let status = if report.is_free() { "success" } else { "collision" };
             (status, p.waypoints.to_vec())
@@ -339,9 +339,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             path.file_name().map(|n| n.to_string_lossy()).unwrap_or_default()
         );
         let text = std::fs::read_to_string(path).map_err(|e| input(format!("{}: {e}", path.display())))?;
+        let dir = path.parent().unwrap_or(Path::new("."));
         let mut record = match args.planner {
-            Planner::Edmp => run_edmp(args, &text, &name)?,
-            Planner::RrtConnect => run_rrt(args, &text, &name)?,
+            Planner::Edmp => run_edmp(args, &text, dir, &name)?,
+            Planner::RrtConnect => run_rrt(args, &text, dir, &name)?,
         };
         record.family = family.clone();
         record.planner = label.clone();

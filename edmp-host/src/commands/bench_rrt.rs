@@ -2,7 +2,7 @@
 //! one row per family: success within the budget, median and p95 planning time, mean path
 //! length (joint space, radians), as a Markdown table on standard output.
 
-use crate::formats::json::{Goal, parse_problem};
+use crate::formats::json::{Goal, read_problem};
 use crate::rrt::{RrtConfig, path_length, plan};
 use core::time::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -32,8 +32,7 @@ struct Outcome {
 }
 
 fn run_one(path: &Path, budget: Duration, seed: u64) -> Result<Outcome, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let p = parse_problem(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let p = read_problem(path)?;
     let Goal::Joints(goal) = p.goal else {
         return Err(format!("{}: suite problems have joint goals", path.display()));
     };
@@ -42,7 +41,7 @@ fn run_one(path: &Path, budget: Duration, seed: u64) -> Result<Outcome, String> 
         ..RrtConfig::default()
     };
     let began = std::time::Instant::now();
-    let planned = plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene, &p.start, &goal, &config, seed);
+    let planned = plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene(), &p.start, &goal, &config, seed);
     Ok(Outcome {
         ms: began.elapsed().as_secs_f64() * 1e3,
         length: planned.ok().map(|r| path_length(&r.waypoints)),

@@ -58,7 +58,7 @@ pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, Str
     let mut problem = Problem {
         obstacles: Default::default(),
         held: parsed.held,
-        finger: parsed.scene.gripper(),
+        finger: parsed.scene().gripper(),
         start: parsed.start,
         goal,
         seed,
@@ -71,9 +71,9 @@ pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, Str
     }
     // The firmware rebuilds the scene from these numbers: it must be the host's scene exactly.
     let rebuilt = problem.to_scene().map_err(|e| e.to_string())?;
-    if rebuilt.obstacles() != parsed.scene.obstacles()
-        || rebuilt.held() != parsed.scene.held()
-        || rebuilt.gripper() != parsed.scene.gripper()
+    if rebuilt.obstacles() != parsed.scene().obstacles()
+        || rebuilt.held() != parsed.scene().held()
+        || rebuilt.gripper() != parsed.scene().gripper()
     {
         return Err("the wire scene differs from the parsed one".to_owned());
     }

@@ -218,7 +218,7 @@ mod tests {
                     };
                     let mut last = Err(String::new());
                     for s in seed..seed + 4 {
-                        last = plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene, &p.start, &goal, &config, s)
+                        last = plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene(), &p.start, &goal, &config, s)
                             .map(|_| ())
                             .map_err(|e| format!("{}: {e:?}", path.display()));
                         if last.is_ok() {
@@ -274,7 +274,7 @@ mod tests {
                         if !PANDA.within_soft_limits(q, 1e-5) {
                             return Err(format!("{name}: {end} outside the joint limits"));
                         }
-                        if check_state(&p.scene, q, &CheckConfig::default()) != Ok(None) {
+                        if check_state(&p.scene(), q, &CheckConfig::default()) != Ok(None) {
                             return Err(format!("{name}: {end} not free"));
                         }
                     }
@@ -294,7 +294,7 @@ mod tests {
                         budget: Duration::from_secs(60),
                         ..RrtConfig::default()
                     };
-                    plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene, &p.start, &goal, &config, seed)
+                    plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene(), &p.start, &goal, &config, seed)
                         .map(|_| ())
                         .map_err(|e| format!("{name}: {e:?}"))
                 })

@@ -4,7 +4,7 @@
 //! nothing written.
 
 use crate::Failure;
-use crate::formats::json::parse_problem;
+use crate::formats::json::parse_problem_in;
 use crate::formats::plan::{add_trajectory, plan_document};
 use crate::formats::trajectory::TimedArgs;
 use crate::planning::{chosen_guides, plan_problem_on};
@@ -381,7 +381,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let began = Instant::now();
     let text =
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
-    let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let dir = args.scene.parent().unwrap_or(std::path::Path::new("."));
+    let problem = parse_problem_in(&text, dir).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let guides = args.tuning.guides(&args.guides)?;
     let mut config = args.tuning.config()?;
     if args.candidates {

@@ -6,7 +6,7 @@
 //! colour per collision-free candidate, grey for colliding ones.
 //! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
 
-use crate::formats::json::{Goal, parse_problem};
+use crate::formats::json::{Goal, parse_problem_in};
 use crate::formats::plan::parse_plan;
 use edmp_core::collision::convex::{Convex, Solid};
 use edmp_core::robot::kinematics::{Joints, forward, forward_with};
@@ -248,7 +248,8 @@ fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, finger: f32, color: [f32; 3]
 /// Draws the scene (and plan) and writes the PNG.
 pub fn run(args: &Args) -> Result<(), String> {
     let text = std::fs::read_to_string(&args.scene).map_err(|e| format!("{}: {e}", args.scene.display()))?;
-    let problem = parse_problem(&text).map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    let dir = args.scene.parent().unwrap_or(std::path::Path::new("."));
+    let problem = parse_problem_in(&text, dir).map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let plan = match &args.plan {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -282,10 +283,10 @@ pub fn run(args: &Args) -> Result<(), String> {
             1.0,
         );
     }
-    for o in problem.scene.obstacles() {
+    for o in problem.scene().obstacles() {
         draw(&mut canvas, &outline(&Solid::obstacle(o)), [0.35, 0.35, 0.38], 0.45);
     }
-    let finger = problem.scene.gripper();
+    let finger = problem.scene().gripper();
     let path = plan.as_ref().map(|p| &p.waypoints);
     if let Some(path) = &path {
         let n = path.len().max(1);

@@ -2,7 +2,7 @@
 //! `edmp-plan/1` plan (status "success" only: without a path nothing is written, exit 1).
 
 use crate::Failure;
-use crate::formats::json::{joint_goal, parse_problem};
+use crate::formats::json::{joint_goal, parse_problem_in};
 use crate::rrt::{RrtConfig, RrtError, path_length, plan};
 use core::time::Duration;
 use serde_json::json;
@@ -30,14 +30,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let began = Instant::now();
     let text =
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
-    let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let dir = args.scene.parent().unwrap_or(std::path::Path::new("."));
+    let problem = parse_problem_in(&text, dir).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let goal = joint_goal(&problem).map_err(Failure::Input)?;
     let config = RrtConfig {
         budget: Duration::from_millis(args.budget_ms),
         ..RrtConfig::default()
     };
     let planned =
-        plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&problem.scene, &problem.start, &goal, &config, args.seed)
+        plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&problem.scene(), &problem.start, &goal, &config, args.seed)
             .map_err(|e| match e {
                 RrtError::Timeout => Failure::NoPath(format!("no path within {} ms", args.budget_ms)),
                 RrtError::Resample => Failure::NoPath("the resampled path cut into an obstacle".into()),

@@ -7,7 +7,7 @@
 //! trajectories; `--plot` draws some samples, joint by joint, to a PNG.
 
 use crate::commands::render::Canvas;
-use crate::formats::json::{Goal, parse_problem};
+use crate::formats::json::{Goal, read_problem};
 use crate::metrics::{Roughness, roughness, step_norm};
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::path::{HORIZON, Path};
@@ -178,8 +178,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     let mut problems = Vec::new();
     for (_, files) in crate::commands::gen_suite::read_folder(&args.problems, args.per_family)? {
         for path in files {
-            let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let p = parse_problem(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+            let p = read_problem(&path)?;
             let Goal::Joints(goal) = p.goal else {
                 return Err(format!("{}: suite problems have joint goals", path.display()));
             };

@@ -2,6 +2,7 @@
 //! errors that name the offending field by its JSON path, e.g. `obstacles[3].quaternion: norm
 //! 0.71, expected 1`, and writing a primitive back.
 
+use super::surface::{SURFACE_BOXES, Surfaces, build_surfaces, is_surface, read_obstacle};
 use edmp_core::collision::checker::{CheckConfig, Contact, check_end};
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
@@ -9,6 +10,7 @@ use edmp_core::robot::{BODY_NAMES, FINGER_OPENING_MAX, FINGER_OPENING_MIN, JOINT
 use edmp_core::scene::{MAX_OBSTACLES, Primitive, QUATERNION_NORM_TOLERANCE, Scene, SceneError, rotation_from_wxyz};
 use serde_json::{Map, Value, json};
 use std::fmt;
+use std::path::Path;
 
 /// A field of the input that is wrong, and why.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -53,11 +55,16 @@ pub enum Goal {
 /// A parsed, validated problem.
 #[derive(Clone, Debug)]
 pub struct Problem {
-    /// The obstacles, the held object and the finger opening (`gripper.finger`).
-    pub scene: Scene<MAX_OBSTACLES>,
-    /// The obstacles' parameters as the file gives them, in the scene's order (what the wire to
-    /// firmware carries).
+    /// The primitive obstacles, the held object and the finger opening (`gripper.finger`);
+    /// [`Problem::scene`] adds the clouds and meshes.
+    primitive_scene: Scene<'static, MAX_OBSTACLES>,
+    /// The clouds and meshes, and the pieces the planner holds of them.
+    pub surfaces: Surfaces,
+    /// The primitive obstacles' parameters as the file gives them, in the scene's order (what
+    /// the wire to firmware carries).
     pub primitives: Vec<Primitive>,
+    /// Each primitive's index in the file's `obstacles` (clouds and meshes may stand between).
+    pub primitive_index: Vec<usize>,
     /// The held object's parameters, if any.
     pub held: Option<Primitive>,
     /// The start configuration.
@@ -66,7 +73,7 @@ pub struct Problem {
     pub goal: Goal,
 }
 
-fn object<'a>(v: &'a Value, path: &str, allowed: &[&str]) -> Result<&'a Map<String, Value>, InputError> {
+pub(crate) fn object<'a>(v: &'a Value, path: &str, allowed: &[&str]) -> Result<&'a Map<String, Value>, InputError> {
     let map = v
         .as_object()
         .ok_or_else(|| InputError::at(path, "expected an object"))?;
@@ -125,7 +132,7 @@ pub(crate) fn numbers<const K: usize>(v: &Value, path: &str) -> Result<[f32; K],
     Ok(out)
 }
 
-fn quaternion(v: &Value, path: &str) -> Result<[f32; 4], InputError> {
+pub(crate) fn quaternion(v: &Value, path: &str) -> Result<[f32; 4], InputError> {
     let q = numbers::<4>(v, path)?;
     let norm = q.iter().map(|x| x * x).sum::<f32>().sqrt();
     if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
@@ -237,10 +244,33 @@ fn joints(v: &Value, path: &str) -> Result<Joints<f32>, InputError> {
     Ok(q)
 }
 
-fn describe(contact: Contact) -> String {
+impl Problem {
+    /// The scene to plan in: the primitives, and the clouds and meshes with their boxes.
+    pub fn scene(&self) -> Scene<'_, MAX_OBSTACLES> {
+        with_surfaces(&self.primitive_scene, &self.surfaces)
+    }
+}
+
+fn with_surfaces<'a>(primitives: &Scene<'static, MAX_OBSTACLES>, surfaces: &'a Surfaces) -> Scene<'a, MAX_OBSTACLES> {
+    if surfaces.pieces() == 0 {
+        return primitives.clone();
+    }
+    primitives.clone().with_surface(surfaces.surface(), SURFACE_BOXES)
+}
+
+/// A contact in words, obstacles named by their index in the file (`primitive_index` maps the
+/// scene's primitives to it).
+pub fn describe(contact: Contact, primitive_index: &[usize]) -> String {
     let body = |b: u8| BODY_NAMES.get(usize::from(b)).copied().unwrap_or("held_object");
     match contact {
-        Contact::Obstacle { body: b, obstacle } => format!("{} touches obstacles[{obstacle}]", body(b)),
+        Contact::Obstacle { body: b, obstacle } => {
+            let i = primitive_index
+                .get(usize::from(obstacle))
+                .copied()
+                .unwrap_or(usize::from(obstacle));
+            format!("{} touches obstacles[{i}]", body(b))
+        }
+        Contact::Surface { body: b, obstacle } => format!("{} touches obstacles[{obstacle}]", body(b)),
         Contact::SelfContact { first, second } => format!("{} touches {}", body(first), body(second)),
     }
 }
@@ -256,15 +286,29 @@ pub fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
                 rotation,
                 translation: position.into(),
             };
-            solve(&target, &problem.start, &problem.scene, &IkConfig::default())
+            solve(&target, &problem.start, &problem.scene(), &IkConfig::default())
                 .map(|s| s.joints)
                 .map_err(|e| format!("goal.pose: unreachable: {e}"))
         }
     }
 }
 
-/// Parses and validates an `edmp-scene/1` document.
+/// Parses and validates an `edmp-scene/1` document whose files (clouds, meshes) lie relative
+/// to the current directory.
 pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
+    parse_problem_in(text, Path::new("."))
+}
+
+/// Reads and validates the `edmp-scene/1` file at `path`: files it names lie relative to its
+/// folder. The error names the file.
+pub fn read_problem(path: &Path) -> Result<Problem, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    parse_problem_in(&text, dir).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Parses and validates an `edmp-scene/1` document; files it names lie relative to `dir`.
+pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
     let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
     // `meta` (optional, free-form provenance such as the family, seed and the TCP pose of a
     // joint goal) is an extension of the format; the planner ignores it.
@@ -288,15 +332,23 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
     let list = obstacles
         .as_array()
         .ok_or_else(|| InputError::at(&op, "expected an array"))?;
-    if list.len() > MAX_OBSTACLES {
+    let primitive_count = list.iter().filter(|o| !is_surface(o)).count();
+    if primitive_count > MAX_OBSTACLES {
         return Err(InputError::at(
             &op,
-            format!("{} obstacles, at most {MAX_OBSTACLES}", list.len()),
+            format!("{primitive_count} primitive obstacles, at most {MAX_OBSTACLES}"),
         ));
     }
     let mut scene = Scene::<MAX_OBSTACLES>::new();
     let mut primitives = Vec::with_capacity(list.len());
+    let mut primitive_index = Vec::with_capacity(list.len());
+    let mut surface_obstacles = Vec::new();
     for (i, o) in list.iter().enumerate() {
+        if is_surface(o) {
+            surface_obstacles.push(read_obstacle(o, &format!("obstacles[{i}]"), i, dir)?);
+            continue;
+        }
+        primitive_index.push(i);
         let p = primitive(o, &format!("obstacles[{i}]"))?;
         let built = p.to_obstacle().map_err(|e| InputError::at(&op, e.to_string()))?;
         scene.push(built).map_err(|e| InputError::at(&op, e.to_string()))?;
@@ -327,10 +379,17 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
     }
     let (start, sp) = field(map, "", "start")?;
     let start = joints(start, &sp)?;
+    // After the start is known: `filter_robot` drops the points the robot has there.
+    let surfaces = build_surfaces(surface_obstacles, &start, scene.gripper())?;
+    let primitive_scene = scene;
+    let scene = with_surfaces(&primitive_scene, &surfaces);
     if let Some(c) =
         check_end(&scene, &start, &CheckConfig::default()).map_err(|e| InputError::at(&sp, e.to_string()))?
     {
-        return Err(InputError::at(&sp, format!("in collision: {}", describe(c))));
+        return Err(InputError::at(
+            &sp,
+            format!("in collision: {}", describe(c, &primitive_index)),
+        ));
     }
     let (goal, gp) = field(map, "", "goal")?;
     let goal_map = object(goal, &gp, &["joints", "pose"])?;
@@ -341,7 +400,10 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
             if let Some(c) =
                 check_end(&scene, &q, &CheckConfig::default()).map_err(|e| InputError::at(&path, e.to_string()))?
             {
-                return Err(InputError::at(&path, format!("in collision: {}", describe(c))));
+                return Err(InputError::at(
+                    &path,
+                    format!("in collision: {}", describe(c, &primitive_index)),
+                ));
             }
             Goal::Joints(q)
         }
@@ -357,9 +419,12 @@ pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
         }
         _ => return Err(InputError::at(&gp, "expected exactly one of \"joints\" or \"pose\"")),
     };
+    drop(scene);
     Ok(Problem {
-        scene,
+        primitive_scene,
+        surfaces,
         primitives,
+        primitive_index,
         held,
         start,
         goal,
@@ -389,8 +454,8 @@ mod tests {
     #[test]
     fn parses_the_spec_example() {
         let p = parse_problem(GOOD).unwrap();
-        assert_eq!(p.scene.obstacles().len(), 3);
-        assert!(p.scene.held().is_some());
+        assert_eq!(p.scene().obstacles().len(), 3);
+        assert!(p.scene().held().is_some());
         assert!(matches!(p.goal, Goal::Joints(_)));
     }
 
@@ -432,10 +497,10 @@ mod tests {
 
     #[test]
     fn the_gripper_field_sets_the_finger_opening() {
-        assert_eq!(parse_problem(GOOD).unwrap().scene.gripper(), 0.025);
+        assert_eq!(parse_problem(GOOD).unwrap().scene().gripper(), 0.025);
         for (text, w) in [("0.04", 0.04), ("0", 0.0), ("0.0125", 0.0125)] {
             let p = parse_problem(&with_gripper(&format!(r#"{{"finger": {text}}}"#))).unwrap();
-            assert_eq!(p.scene.gripper(), w);
+            assert_eq!(p.scene().gripper(), w);
         }
         let cases = [
             (r#"{"finger": 0.05}"#, "gripper.finger: 0.05 outside [0, 0.04]"),

@@ -1,8 +1,8 @@
 //! The file formats, one reader and writer each, shared by the commands and the Python
 //! package (docs/formats.md): the `edmp-scene/1` scene ([`json`]), the `edmp-plan/1` plan
 //! ([`plan`]) and its timed `trajectory` ([`trajectory`]), MoveIt's planning scenes ([`moveit`]),
-//! and the geometry files that `points` and `mesh` obstacles will name (not yet wired into
-//! scenes): point clouds from PLY and PCD ([`cloud`]) and triangle meshes from OBJ, STL and PLY
+//! the `points` and `mesh` obstacles ([`surface`]) and the geometry files they name: point
+//! clouds from PLY and PCD ([`cloud`]) and triangle meshes from OBJ, STL and PLY
 //! ([`mesh_file`]), with their one error ([`file_error`]).
 
 pub mod cloud;
@@ -14,4 +14,5 @@ pub mod plan;
 mod ply;
 #[cfg(test)]
 mod robustness;
+pub mod surface;
 pub mod trajectory;

@@ -34,7 +34,7 @@ pub fn plan_document(
         cylinder: config.cylinder,
         frame: config.frame,
     };
-    let intersection = trajectory_cost(&problem.scene, best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
+    let intersection = trajectory_cost(&problem.scene(), best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
     let per_guide = ROWS / guides.len();
     let guide_of = |row: usize| guides[row / per_guide].id;
     let status = if plan.is_free() { "success" } else { "collision" };
@@ -101,7 +101,7 @@ pub fn add_trajectory(
         return Ok(false);
     };
     let began = Instant::now();
-    doc["trajectory"] = trajectory_document(&problem.scene, path, &config.check, request)?;
+    doc["trajectory"] = trajectory_document(&problem.scene(), path, &config.check, request)?;
     doc["timing_ms"]["trajectory"] = json!(began.elapsed().as_secs_f64() * 1e3);
     Ok(true)
 }

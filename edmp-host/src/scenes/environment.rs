@@ -220,7 +220,7 @@ pub(crate) struct Environment {
 
 impl Environment {
     /// The environment as a core scene (`None` if a primitive is invalid or too many).
-    pub(crate) fn scene(&self) -> Option<Scene<MAX_OBSTACLES>> {
+    pub(crate) fn scene(&self) -> Option<Scene<'static, MAX_OBSTACLES>> {
         let mut scene = Scene::new();
         for p in &self.prims {
             scene.push(p.to_obstacle().ok()?).ok()?;

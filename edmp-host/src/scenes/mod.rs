@@ -99,7 +99,7 @@ pub(crate) struct Problem {
     pub kind: Kind,
     pub seed: u64,
     pub env: Environment,
-    pub scene: Scene<MAX_OBSTACLES>,
+    pub scene: Scene<'static, MAX_OBSTACLES>,
     pub start: Joints<f32>,
     pub goal: Joints<f32>,
     pub goal_pose: Pose<f32>,
@@ -211,7 +211,7 @@ fn targeted(
     kind: Kind,
     seed: u64,
     env: Environment,
-    scene: Scene<MAX_OBSTACLES>,
+    scene: Scene<'static, MAX_OBSTACLES>,
     rng: &mut Rng,
 ) -> Option<Problem> {
     let target = env.goals[rng.below(env.goals.len() as u32) as usize];

@@ -8,7 +8,7 @@
 //! at those poses and interpolates between samples; it computes no kinematics.
 
 use crate::Failure;
-use crate::formats::json::{Goal, Problem, parse_problem};
+use crate::formats::json::{Goal, Problem, parse_problem_in};
 use crate::formats::plan::{PlanDocument, parse_plan};
 use edmp_core::robot::kinematics::{Joints, Pose, forward_with};
 use edmp_core::robot::{FRAME_NAMES, FRAMES, HAND_FRAME, TCP_FRAME};
@@ -110,7 +110,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let read =
         |path: &Path| std::fs::read_to_string(path).map_err(|e| Failure::Input(format!("{}: {e}", path.display())));
     let text = read(&args.scene)?;
-    let problem = parse_problem(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let dir = args.scene.parent().unwrap_or(Path::new("."));
+    let problem = parse_problem_in(&text, dir).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let plan = match &args.plan {
         Some(path) => Some(parse_plan(&read(path)?).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?),
         None => None,
@@ -260,7 +261,7 @@ fn tcp_path(path: &[Joints<f32>], finger: f32, at: &str) -> Result<Vec<[f64; 3]>
 }
 
 fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Result<Value, String> {
-    let finger = problem.scene.gripper();
+    let finger = problem.scene().gripper();
     let mut times = Vec::new();
     let mut poses = Vec::new();
     let mut tcp = Vec::new();
@@ -310,8 +311,8 @@ fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Res
         "tcp_frame": TCP_FRAME,
         "hand_frame": HAND_FRAME,
         "meshes": robot_meshes()?,
-        "obstacles": problem.scene.obstacles().iter().map(primitive).collect::<Vec<_>>(),
-        "held": problem.scene.held().map(primitive),
+        "obstacles": problem.scene().obstacles().iter().map(primitive).collect::<Vec<_>>(),
+        "held": problem.scene().held().map(primitive),
         "samples": {"times": times, "poses": poses, "tcp": tcp},
         "start_tcp": start_tcp,
         "goal_tcp": goal_tcp,
@@ -544,7 +545,7 @@ mod tests {
 
     #[test]
     fn a_timed_trajectory_plays_at_its_own_times_thinned_to_the_sample_rate() {
-        let problem = parse_problem(include_str!("../../../../examples/wall.json")).unwrap();
+        let problem = crate::formats::json::parse_problem(include_str!("../../../../examples/wall.json")).unwrap();
         let (a, b) = (problem.start, [0.3, -0.5, 0.1, -2.0, 0.0, 1.6, 0.9]);
         // 1 kHz over 1.5 s: thinned to every 20th point (50 per second) and the last.
         let trajectory: Vec<(f32, Joints<f32>)> = (0..=1500)
@@ -567,7 +568,7 @@ mod tests {
         assert_eq!((times[0], times[1], times[75]), (0.0, 0.02, 1.5));
         assert_eq!(data["title"], "t</script>");
         // Each sample is the core's FK of its trajectory point: 13 frames, the TCP as its own.
-        let k = forward_with(&trajectory[1500].1, problem.scene.gripper()).unwrap();
+        let k = forward_with(&trajectory[1500].1, problem.scene().gripper()).unwrap();
         let tcp: [f64; 3] = serde_json::from_value(data["samples"]["tcp"][75].clone()).unwrap();
         let poses: Vec<f64> = serde_json::from_value(data["samples"]["poses"][75].clone()).unwrap();
         assert_eq!(poses.len(), 7 * FRAMES);

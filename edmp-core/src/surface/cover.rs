@@ -1,0 +1,139 @@
+//! Boxes around a surface for the guides. EDMP's costs are intersection and swept volumes of
+//! the arm's link boxes with obstacle boxes; a cloud or a mesh joins them as a few boxes, each
+//! around one subtree of the hierarchy, turned about z to fit its pieces (the walls of a
+//! shelf stand at any yaw). The guides only steer: the checker still judges the exact pieces.
+
+use crate::collision::convex::Convex;
+use crate::scene::Obstacle;
+use crate::surface::Surface;
+use crate::surface::bvh::Node;
+use nalgebra::Vector3;
+
+/// The most boxes one surface gets.
+pub const MAX_COVERS: usize = 64;
+
+/// Thinnest box side (metres): a flat wall's box keeps a thickness the costs can measure.
+pub const MIN_SIDE: f32 = 0.005;
+
+/// Up to `out.len()` (at most [`MAX_COVERS`]) boxes that together hold every piece of
+/// `surface`; returns how many were written. The subtree with the largest box is split until
+/// the boxes are used up or only leaves are left. Deterministic.
+pub fn covers(surface: &Surface<'_>, out: &mut [Obstacle]) -> usize {
+    let nodes = surface.nodes();
+    let limit = out.len().min(MAX_COVERS);
+    if surface.is_empty() || nodes.is_empty() || limit == 0 {
+        return 0;
+    }
+    let mut frontier: heapless::Vec<u32, MAX_COVERS> = heapless::Vec::new();
+    let _ = frontier.push(0);
+    while frontier.len() < limit {
+        // The splittable node with the largest box (the first such, on ties).
+        let mut pick: Option<(usize, f32)> = None;
+        for (k, &i) in frontier.iter().enumerate() {
+            if let Some(n) = nodes.get(i as usize)
+                && n.left != 0
+            {
+                let v = n.bounds().volume();
+                if pick.is_none_or(|(_, best)| v > best) {
+                    pick = Some((k, v));
+                }
+            }
+        }
+        let Some((k, _)) = pick else { break };
+        let Some(left) = frontier.get(k).and_then(|&i| nodes.get(i as usize)).map(|n| n.left) else {
+            break;
+        };
+        if let Some(slot) = frontier.get_mut(k) {
+            *slot = left;
+        }
+        if frontier.push(left + 1).is_err() {
+            break;
+        }
+    }
+    let mut written = 0;
+    for (slot, &i) in out.iter_mut().zip(frontier.iter()) {
+        if let Some(b) = nodes.get(i as usize).and_then(|n| fitted(surface, n)) {
+            *slot = b;
+            written += 1;
+        }
+    }
+    // Boxes that could not be fitted (none in practice) leave no gap in `out`.
+    written
+}
+
+/// The box around one node's pieces, turned about z by the principal axis of their centroids.
+fn fitted(surface: &Surface<'_>, node: &Node) -> Option<Obstacle> {
+    let end = node.first as usize + node.count as usize;
+    let pieces = surface.pieces().get(node.first as usize..end)?;
+    let n = pieces.len() as f32;
+    if pieces.is_empty() {
+        return None;
+    }
+    let mean = pieces.iter().fold(Vector3::zeros(), |m, e| m + e.centroid()) / n;
+    let (mut xx, mut xy, mut yy) = (0.0f32, 0.0f32, 0.0f32);
+    for e in pieces {
+        let d = e.centroid() - mean;
+        xx += d.x * d.x;
+        xy += d.x * d.y;
+        yy += d.y * d.y;
+    }
+    let angle = 0.5 * libm::atan2f(2.0 * xy, xx - yy);
+    let (s, c) = (libm::sinf(angle), libm::cosf(angle));
+    let axes = [Vector3::new(c, s, 0.0), Vector3::new(-s, c, 0.0), Vector3::z()];
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for e in pieces {
+        for (k, a) in axes.iter().enumerate() {
+            hi[k] = hi[k].max(e.support(a).dot(a));
+            lo[k] = lo[k].min(e.support(&-a).dot(a));
+        }
+    }
+    let mid: [f32; 3] = core::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
+    let center = axes[0] * mid[0] + axes[1] * mid[1] + axes[2] * mid[2];
+    let dims: [f32; 3] = core::array::from_fn(|k| (hi[k] - lo[k]).max(MIN_SIDE));
+    let half = 0.5 * angle;
+    let quaternion = [libm::cosf(half), 0.0, 0.0, libm::sinf(half)];
+    Obstacle::cuboid(center.into(), dims, quaternion).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collision::convex::Solid;
+    use crate::surface::bvh::{build, nodes_for};
+    use crate::surface::element::Element;
+    use std::vec::Vec;
+
+    #[test]
+    fn a_turned_wall_gets_a_turned_box_that_holds_every_ball() {
+        // A 1 m × 0.5 m wall of points turned 30° about z.
+        let (s, c) = (0.5f32, 0.866_025_4f32);
+        let mut pieces: Vec<Element> = (0..5000)
+            .map(|i| {
+                let (u, z) = ((i % 100) as f32 * 0.01 - 0.5, (i / 100) as f32 * 0.01);
+                Element::ball([0.6 + u * c, u * s, z], 0.0075, 0).unwrap()
+            })
+            .collect();
+        let mut nodes = std::vec![Node { lo: [0.0; 3], hi: [0.0; 3], first: 0, count: 0, left: 0 }; nodes_for(5000)];
+        let used = build(&mut pieces, &mut nodes).unwrap();
+        let surface = Surface::new(&pieces, &nodes[..used]).unwrap();
+        let mut out = [Obstacle::sphere([0.0; 3], 1.0).unwrap(); 1];
+        assert_eq!(covers(&surface, &mut out), 1);
+        let Solid {
+            shape,
+            rotation,
+            center,
+        } = Solid::obstacle(&out[0]);
+        let crate::scene::Shape::Cuboid { dims } = shape else {
+            panic!()
+        };
+        // Thin across the wall (the balls' diameter), not the 0.5 m an axis-aligned box needs.
+        assert!(dims.y < 0.02 && dims.x > 1.0, "{dims:?}");
+        for e in &pieces {
+            let local = rotation.tr_mul(&(e.centroid() - center));
+            assert!((0..3).all(|k| local[k].abs() <= 0.5 * dims[k] + 1e-4));
+        }
+        let mut many = [out[0]; 8];
+        assert_eq!(covers(&surface, &mut many), 8);
+    }
+}

@@ -1,0 +1,364 @@
+//! The `points` and `mesh` obstacles of `edmp-scene/1` (docs/formats.md, "Point clouds and
+//! meshes"): read inline or from files beside the scene, placed in the world, the robot's own
+//! points dropped, a cloud reduced when it exceeds the capacity, and built into the buffers a
+//! core [`Surface`] borrows.
+
+use super::file_error::FileError;
+use super::json::{InputError, field, number, numbers, object, quaternion};
+use super::{cloud, mesh_file};
+use edmp_core::robot::kinematics::Joints;
+use edmp_core::scene::rotation_from_wxyz;
+use edmp_core::surface::Surface;
+use edmp_core::surface::bvh::{Node, build, nodes_for};
+use edmp_core::surface::element::{Element, SurfaceError};
+use edmp_core::surface::points::{Reduced, filter_robot, reduce};
+use nalgebra::{Matrix3, Vector3};
+use serde_json::Value;
+use std::path::Path;
+
+/// The most pieces (cloud balls and mesh triangles, all obstacles together) the host holds:
+/// a 640 × 480 camera's 307,200 points are reduced to fit; a 200,000-point cloud is kept whole.
+pub const MAX_PIECES: usize = 1 << 18;
+
+/// The most boxes the guides get around a scene's clouds and meshes (fewer when the scene's
+/// obstacle capacity runs out first).
+pub const SURFACE_BOXES: usize = 24;
+
+/// A cloud or a mesh as the scene gives it, in the world frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SurfaceKind {
+    /// Balls of `radius` around the points (after `filter_robot`, before any reduction).
+    Points {
+        /// The points, in the world.
+        points: Vec<[f32; 3]>,
+        /// The ball radius.
+        radius: f32,
+        /// The robot's own points were those within this distance of it at `start`.
+        filter_robot: Option<f32>,
+    },
+    /// Triangles (degenerate ones included: the core ignores them).
+    Mesh {
+        /// Vertices, in the world.
+        vertices: Vec<[f32; 3]>,
+        /// Vertex indices, checked to be in range.
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+/// A `points` or `mesh` obstacle and its index in the scene's `obstacles`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceObstacle {
+    /// Index in `obstacles`.
+    pub index: usize,
+    /// The geometry.
+    pub kind: SurfaceKind,
+}
+
+/// Every cloud and mesh of a scene, and the core's pieces and tree over them.
+#[derive(Clone, Debug, Default)]
+pub struct Surfaces {
+    /// The obstacles as read (clouds filtered, not reduced).
+    pub obstacles: Vec<SurfaceObstacle>,
+    /// How many cloud points `filter_robot` dropped, all clouds together.
+    pub points_filtered: usize,
+    /// Per reduced cloud (its obstacle index), how it was reduced.
+    pub reduced: Vec<(usize, Reduced)>,
+    pieces: Vec<Element>,
+    nodes: Vec<Node>,
+}
+
+impl Surfaces {
+    /// The view the core's scene borrows.
+    pub fn surface(&self) -> Surface<'_> {
+        // Built by `bvh::build` over exactly these pieces: `Surface::new` accepts it.
+        Surface::new(&self.pieces, &self.nodes).unwrap_or(Surface::EMPTY)
+    }
+
+    /// Pieces held (balls and non-degenerate triangles).
+    pub fn pieces(&self) -> usize {
+        self.pieces.len()
+    }
+}
+
+/// Whether an obstacle's `type` is one of these.
+pub fn is_surface(v: &Value) -> bool {
+    matches!(v.get("type").and_then(Value::as_str), Some("points" | "mesh"))
+}
+
+/// Where a cloud's or a mesh's own frame stands: world = centre + rotation · (scale ⊙ local).
+struct Placement {
+    center: Vector3<f32>,
+    rotation: Matrix3<f32>,
+    scale: Vector3<f32>,
+}
+
+fn placement(map: &serde_json::Map<String, Value>, path: &str, scaled: bool) -> Result<Placement, InputError> {
+    let center = match map.get("center") {
+        Some(c) => Vector3::from(numbers::<3>(c, &format!("{path}.center"))?),
+        None => Vector3::zeros(),
+    };
+    let rotation = match map.get("quaternion") {
+        Some(q) => {
+            let qp = format!("{path}.quaternion");
+            rotation_from_wxyz(quaternion(q, &qp)?).map_err(|e| InputError::at(&qp, e.to_string()))?
+        }
+        None => Matrix3::identity(),
+    };
+    let scale = match map.get("scale").filter(|_| scaled) {
+        None => Vector3::repeat(1.0),
+        Some(s) => {
+            let sp = format!("{path}.scale");
+            let v = if s.is_number() {
+                Vector3::repeat(number(s, &sp)?)
+            } else {
+                Vector3::from(numbers::<3>(s, &sp)?)
+            };
+            if v.iter().any(|&x| x <= 0.0) {
+                return Err(InputError::at(&sp, "must be positive"));
+            }
+            v
+        }
+    };
+    Ok(Placement {
+        center,
+        rotation,
+        scale,
+    })
+}
+
+fn place(points: &mut [[f32; 3]], at: Placement, path: &str) -> Result<(), InputError> {
+    for p in points.iter_mut() {
+        let w = at.center + at.rotation * Vector3::from(*p).component_mul(&at.scale);
+        if w.iter().any(|x| !x.is_finite()) {
+            return Err(InputError::at(path, "a placed coordinate is not a finite f32"));
+        }
+        *p = w.into();
+    }
+    Ok(())
+}
+
+fn file_error(path: &str, e: FileError) -> InputError {
+    InputError::at(&format!("{path}.file"), e.to_string())
+}
+
+fn inline_points(v: &Value, path: &str) -> Result<Vec<[f32; 3]>, InputError> {
+    let items = v
+        .as_array()
+        .ok_or_else(|| InputError::at(path, "expected an array of [x, y, z]"))?;
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, p)| numbers::<3>(p, &format!("{path}[{i}]")))
+        .collect()
+}
+
+/// A `points` or `mesh` obstacle at `path` (index `index` of `obstacles`), files read
+/// relative to `dir`, placed in the world.
+pub fn read_obstacle(v: &Value, path: &str, index: usize, dir: &Path) -> Result<SurfaceObstacle, InputError> {
+    let kind = match v.get("type").and_then(Value::as_str) {
+        Some("points") => {
+            let map = object(
+                v,
+                path,
+                &[
+                    "type",
+                    "points",
+                    "file",
+                    "radius",
+                    "filter_robot",
+                    "center",
+                    "quaternion",
+                ],
+            )?;
+            let mut points = match (map.get("points"), map.get("file")) {
+                (Some(p), None) => inline_points(p, &format!("{path}.points"))?,
+                (None, Some(f)) => {
+                    let fp = format!("{path}.file");
+                    let name = f.as_str().ok_or_else(|| InputError::at(&fp, "expected a file path"))?;
+                    cloud::read_points(&dir.join(name)).map_err(|e| file_error(path, e))?
+                }
+                _ => return Err(InputError::at(path, "expected exactly one of \"points\" or \"file\"")),
+            };
+            let (r, rp) = field(map, path, "radius")?;
+            let radius = number(r, &rp)?;
+            if radius <= 0.0 {
+                return Err(InputError::at(&rp, "must be positive"));
+            }
+            let filter_robot = match map.get("filter_robot") {
+                Some(d) => {
+                    let dp = format!("{path}.filter_robot");
+                    let d = number(d, &dp)?;
+                    if d < 0.0 {
+                        return Err(InputError::at(&dp, "must not be negative"));
+                    }
+                    Some(d)
+                }
+                None => None,
+            };
+            place(&mut points, placement(map, path, false)?, path)?;
+            SurfaceKind::Points {
+                points,
+                radius,
+                filter_robot,
+            }
+        }
+        Some("mesh") => {
+            let map = object(
+                v,
+                path,
+                &["type", "file", "vertices", "triangles", "center", "quaternion", "scale"],
+            )?;
+            let mut mesh = match (map.get("file"), map.get("vertices"), map.get("triangles")) {
+                (Some(f), None, None) => {
+                    let fp = format!("{path}.file");
+                    let name = f.as_str().ok_or_else(|| InputError::at(&fp, "expected a file path"))?;
+                    mesh_file::read_mesh(&dir.join(name)).map_err(|e| file_error(path, e))?
+                }
+                (None, Some(v), Some(t)) => {
+                    let vertices = inline_points(v, &format!("{path}.vertices"))?;
+                    let tp = format!("{path}.triangles");
+                    let items = t
+                        .as_array()
+                        .ok_or_else(|| InputError::at(&tp, "expected an array of [i, j, k]"))?;
+                    let mut triangles = Vec::with_capacity(items.len());
+                    for (i, tri) in items.iter().enumerate() {
+                        let ip = format!("{tp}[{i}]");
+                        let ks = tri
+                            .as_array()
+                            .filter(|a| a.len() == 3)
+                            .ok_or_else(|| InputError::at(&ip, "expected 3 vertex indices"))?;
+                        let mut out = [0u32; 3];
+                        for (k, (slot, x)) in out.iter_mut().zip(ks).enumerate() {
+                            *slot = x.as_u64().filter(|&n| (n as usize) < vertices.len()).ok_or_else(|| {
+                                InputError::at(
+                                    &format!("{ip}[{k}]"),
+                                    format!("expected a vertex index below {}, found {x}", vertices.len()),
+                                )
+                            })? as u32;
+                        }
+                        triangles.push(out);
+                    }
+                    mesh_file::TriangleMesh { vertices, triangles }
+                }
+                _ => {
+                    return Err(InputError::at(
+                        path,
+                        "expected either \"file\" or both \"vertices\" and \"triangles\"",
+                    ));
+                }
+            };
+            place(&mut mesh.vertices, placement(map, path, true)?, path)?;
+            SurfaceKind::Mesh {
+                vertices: mesh.vertices,
+                triangles: mesh.triangles,
+            }
+        }
+        _ => {
+            return Err(InputError::at(
+                &format!("{path}.type"),
+                "expected \"points\" or \"mesh\"",
+            ));
+        }
+    };
+    Ok(SurfaceObstacle { index, kind })
+}
+
+fn surface_error(e: SurfaceError, path: &str) -> InputError {
+    InputError::at(path, e.to_string())
+}
+
+/// Drops each cloud's robot points at `start` (fingers at `finger`), reduces clouds beyond
+/// the capacity left by the meshes, and builds the pieces and their tree.
+pub fn build_surfaces(
+    mut obstacles: Vec<SurfaceObstacle>,
+    start: &Joints<f32>,
+    finger: f32,
+) -> Result<Surfaces, InputError> {
+    let mut points_filtered = 0;
+    let mut pieces = Vec::new();
+    let triangles: usize = obstacles
+        .iter()
+        .map(|o| match &o.kind {
+            SurfaceKind::Mesh { triangles, .. } => triangles.len(),
+            SurfaceKind::Points { .. } => 0,
+        })
+        .sum();
+    if triangles > MAX_PIECES {
+        return Err(InputError::at(
+            "obstacles",
+            format!("{triangles} mesh triangles, at most {MAX_PIECES}"),
+        ));
+    }
+    let mut clouds_left = obstacles
+        .iter()
+        .filter(|o| matches!(o.kind, SurfaceKind::Points { .. }))
+        .count();
+    let mut room = MAX_PIECES - triangles;
+    let mut reduced = Vec::new();
+    for o in obstacles.iter_mut() {
+        let path = format!("obstacles[{}]", o.index);
+        let tag = u16::try_from(o.index).map_err(|_| InputError::at(&path, "obstacle index beyond 65535"))?;
+        match &mut o.kind {
+            SurfaceKind::Points {
+                points,
+                radius,
+                filter_robot: filter,
+            } => {
+                if let Some(d) = *filter {
+                    let kept = filter_robot(points, start, finger, d)
+                        .map_err(|e| InputError::at(&format!("{path}.filter_robot"), e.to_string()))?;
+                    points_filtered += points.len() - kept;
+                    points.truncate(kept);
+                }
+                let mut held = points.clone();
+                let share = room / clouds_left.max(1);
+                let r = reduce(&mut held, *radius, share).map_err(|e| surface_error(e, &path))?;
+                if r.cell > 0.0 {
+                    reduced.push((o.index, r));
+                }
+                for p in held.iter().take(r.points) {
+                    pieces.push(Element::ball(*p, r.radius, tag).map_err(|e| surface_error(e, &path))?);
+                }
+                room -= r.points;
+                clouds_left -= 1;
+            }
+            SurfaceKind::Mesh { vertices, triangles } => {
+                for t in triangles.iter() {
+                    let corner = |i: u32| {
+                        vertices
+                            .get(i as usize)
+                            .copied()
+                            .ok_or_else(|| InputError::at(&path, format!("vertex index {i} out of range")))
+                    };
+                    let corners = [corner(t[0])?, corner(t[1])?, corner(t[2])?];
+                    if let Some(e) = Element::triangle(corners, tag).map_err(|e| surface_error(e, &path))? {
+                        pieces.push(e);
+                    }
+                }
+            }
+        }
+    }
+    let mut nodes = vec![
+        Node {
+            lo: [0.0; 3],
+            hi: [0.0; 3],
+            first: 0,
+            count: 0,
+            left: 0
+        };
+        nodes_for(pieces.len())
+    ];
+    let used = if pieces.is_empty() {
+        0
+    } else {
+        build(&mut pieces, &mut nodes).map_err(|e| surface_error(e, "obstacles"))?
+    };
+    nodes.truncate(used);
+    Ok(Surfaces {
+        obstacles,
+        points_filtered,
+        reduced,
+        pieces,
+        nodes,
+    })
+}
