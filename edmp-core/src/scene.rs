@@ -4,7 +4,9 @@
 //! the checker never see a NaN, a zero size or a non-rotation.
 
 use crate::robot::{FINGER_OPENING_DEFAULT, FINGER_OPENING_MAX, FINGER_OPENING_MIN};
-use crate::surface::{Surface, cover};
+use crate::surface::Surface;
+#[cfg(doc)]
+use crate::surface::cover;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// Default obstacle capacity of a [`Scene`].
@@ -161,7 +163,8 @@ pub fn rotation_from_wxyz(q: [f32; 4]) -> Result<Matrix3<f32>, SceneError> {
 }
 
 impl Obstacle {
-    /// A unit ball at the origin: fills fixed arrays before they are written.
+    /// A unit ball at the origin: fills fixed arrays before they are written
+    /// (e.g. the output of [`cover::covers`]).
     pub const PLACEHOLDER: Self = Self {
         shape: Shape::Sphere { radius: 1.0 },
         center: Vector3::new(0.0, 0.0, 0.0),
@@ -284,16 +287,15 @@ impl<'a, const N: usize> Scene<'a, N> {
     }
 
     /// This scene with `surface`'s pieces as obstacles: the checker takes them exactly, the
-    /// guides through up to `boxes` boxes around them ([`cover::covers`]), fewer when the
-    /// scene's capacity runs out first. Any earlier surface and its boxes are replaced.
-    pub fn with_surface<'b>(self, surface: Surface<'b>, boxes: usize) -> Scene<'b, N> {
+    /// guides take `boxes` around them ([`cover::covers`]), as many as the scene's capacity
+    /// leaves room for. Any earlier surface and its boxes are replaced.
+    pub fn with_surface<'b>(self, surface: Surface<'b>, boxes: &[Obstacle]) -> Scene<'b, N> {
         let mut obstacles = self.obstacles;
         obstacles.truncate(self.primitives);
-        let mut out = [Obstacle::PLACEHOLDER; cover::MAX_COVERS];
-        let room = N.saturating_sub(self.primitives).min(boxes).min(cover::MAX_COVERS);
-        let made = cover::covers(&surface, out.get_mut(..room).unwrap_or(&mut []));
-        for b in out.iter().take(made) {
-            let _ = obstacles.push(*b);
+        for b in boxes {
+            if obstacles.push(*b).is_err() {
+                break;
+            }
         }
         Scene {
             obstacles,

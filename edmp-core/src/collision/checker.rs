@@ -21,6 +21,7 @@ use crate::robot::kinematics::{Joints, Kinematics, forward_with};
 use crate::robot::reach::{BODY_REACH, HAND_REACH, motion};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Scene, Shape};
+use crate::surface::element::{Element, Piece};
 use core::cmp::Ordering;
 use nalgebra::{Matrix3, Vector3};
 
@@ -215,6 +216,23 @@ impl Placed<'_> {
         }
         // The oriented box holds the hull: proving the box apart is enough, and cheap.
         apart_by(&self.obb(b), p, self.margin, hint).or_else(|| apart_by(&self.hull(b), p, self.margin, hint))
+    }
+
+    /// A cloud's ball proven clear of robot body `b`'s oriented box (which holds its hull) by
+    /// more than `margin`, in closed form: the certified gap, `None` when it is not (or `p` is
+    /// a triangle, or `b` the held object).
+    fn ball_clear_of_box(&self, b: usize, p: &Element, margin: f32) -> Option<f32> {
+        let (Piece::Ball { center, radius }, true) = (p.piece, b < BODIES) else {
+            return None;
+        };
+        let pose = &self.k.boxes[b % BODIES];
+        let half = &PANDA.bodies[b % BODIES].half_extents;
+        let local = pose.rotation.tr_mul(&(center - pose.translation));
+        let outside = local.abs() - half;
+        let d2 = outside.map(|x| x.max(0.0)).norm_squared();
+        // The box's own rounding is far below the 0.1 % `sqrt_below` leaves.
+        let gap = sqrt_below(d2) - radius;
+        (gap > margin).then_some(gap)
     }
 
     /// Bodies `a < b` proven apart: the certified gap, as [`Placed::body_apart_from`].
@@ -474,7 +492,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
                     self.radius[b % SLOTS],
                     margin,
                     SURFACE_HORIZON,
-                    |e| placed.body_apart_from(b, e, hint),
+                    |e| placed.ball_clear_of_box(b, e, margin).or_else(|| placed.body_apart_from(b, e, hint)),
                 );
                 match gap {
                     Ok(gap) => *slack = gap - carry,

@@ -44,8 +44,16 @@ pub const fn nodes_for(pieces: usize) -> usize {
     if pieces == 0 { 1 } else { pieces }
 }
 
-fn bounds_of(pieces: &[Element]) -> Aabb {
-    pieces.iter().fold(Aabb::EMPTY, |b, e| b.union(&e.bounds()))
+/// Moves the pieces for which `left` holds to the front, keeping no order; returns how many.
+fn partition(run: &mut [Element], left: impl Fn(&Element) -> bool) -> usize {
+    let mut front = 0;
+    for i in 0..run.len() {
+        if run.get(i).is_some_and(&left) {
+            run.swap(front, i);
+            front += 1;
+        }
+    }
+    front
 }
 
 /// Builds the tree over `pieces` (reordering them) into `nodes`; returns the number of nodes
@@ -68,7 +76,11 @@ pub fn build(pieces: &mut [Element], nodes: &mut [Node]) -> Result<usize, Surfac
         let Some(run) = pieces.get_mut(first..first + count) else {
             return Err(SurfaceError::TooManyPieces);
         };
-        let b = bounds_of(run);
+        // One pass: the run's box, and the box of its centroids (where it is split).
+        let (b, c) = run.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), e| {
+            let p = e.centroid();
+            (b.union(&e.bounds()), c.union(&Aabb { lo: p, hi: p }))
+        });
         let mut node = Node {
             lo: b.lo.into(),
             hi: b.hi.into(),
@@ -77,10 +89,6 @@ pub fn build(pieces: &mut [Element], nodes: &mut [Node]) -> Result<usize, Surfac
             left: 0,
         };
         if count > LEAF && depth + 2 <= MAX_DEPTH && used + 2 <= nodes.len() {
-            let c = run.iter().fold(Aabb::EMPTY, |b, e| {
-                let p = e.centroid();
-                b.union(&Aabb { lo: p, hi: p })
-            });
             let extent = c.hi - c.lo;
             let axis = if extent.x >= extent.y && extent.x >= extent.z {
                 0
@@ -89,8 +97,14 @@ pub fn build(pieces: &mut [Element], nodes: &mut [Node]) -> Result<usize, Surfac
             } else {
                 2
             };
-            let mid = count / 2;
-            run.select_nth_unstable_by(mid, |a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]));
+            // Split at the middle of the centroids' extent (one pass); when that leaves
+            // fewer than an eighth on one side, at the median instead.
+            let middle = 0.5 * (c.lo[axis] + c.hi[axis]);
+            let mut mid = partition(run, |e| e.centroid()[axis] < middle);
+            if mid < count / 8 || mid > count - count / 8 {
+                mid = count / 2;
+                run.select_nth_unstable_by(mid, |a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]));
+            }
             node.left = used as u32;
             todo[depth] = (used, first, mid);
             todo[depth + 1] = (used + 1, first + mid, count - mid);

@@ -101,10 +101,10 @@ impl<'a> Surface<'a> {
     /// A certified lower bound on the distance from a convex shape to every piece, capped at
     /// `horizon`; `Err(obstacle)` names a piece's obstacle that is not proven clear.
     ///
-    /// The shape lies in the ball of `radius` around `center`. Subtrees and pieces whose box
-    /// is farther than `horizon` from the ball are skipped; a piece whose box the ball's
-    /// distance alone proves more than `near` away counts with that bound; only the others go
-    /// to `prove`, which returns the certified gap (above the caller's margin) or `None`.
+    /// The shape lies in the ball of `radius` around `center`. A subtree or a piece whose box
+    /// the ball's distance alone proves more than `near` away counts with that bound (and a
+    /// subtree is not opened); only the pieces nearer go to `prove`, which returns the
+    /// certified gap (above the caller's margin) or `None`.
     pub fn gap<F>(&self, center: &Vector3<f32>, radius: f32, near: f32, horizon: f32, mut prove: F) -> Result<f32, u16>
     where
         F: FnMut(&Element) -> Option<f32>,
@@ -118,7 +118,11 @@ impl<'a> Surface<'a> {
         let mut depth = 0usize;
         let mut node = *root;
         loop {
-            if bound(&node.bounds()) < best {
+            let lb = bound(&node.bounds());
+            if lb < best && lb > near {
+                // The box alone proves the whole subtree clear: its bound stands for it.
+                best = lb;
+            } else if lb < best {
                 if node.left == 0 {
                     let end = node.first as usize + node.count as usize;
                     for e in self.pieces.get(node.first as usize..end).unwrap_or(&[]) {

@@ -2,7 +2,7 @@
 //! errors that name the offending field by its JSON path, e.g. `obstacles[3].quaternion: norm
 //! 0.71, expected 1`, and writing a primitive back.
 
-use super::surface::{SURFACE_BOXES, Surfaces, build_surfaces, is_surface, read_obstacle};
+use super::surface::{Surfaces, build_surfaces, is_surface, read_obstacle};
 use edmp_core::collision::checker::{CheckConfig, Contact, check_end};
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
@@ -255,7 +255,7 @@ fn with_surfaces<'a>(primitives: &Scene<'static, MAX_OBSTACLES>, surfaces: &'a S
     if surfaces.pieces() == 0 {
         return primitives.clone();
     }
-    primitives.clone().with_surface(surfaces.surface(), SURFACE_BOXES)
+    primitives.clone().with_surface(surfaces.surface(), &surfaces.boxes)
 }
 
 /// A contact in words, obstacles named by their index in the file (`primitive_index` maps the

@@ -7,7 +7,8 @@ use super::file_error::FileError;
 use super::json::{InputError, field, number, numbers, object, quaternion};
 use super::{cloud, mesh_file};
 use edmp_core::robot::kinematics::Joints;
-use edmp_core::scene::rotation_from_wxyz;
+use edmp_core::scene::{Obstacle, rotation_from_wxyz};
+use edmp_core::surface::cover::covers;
 use edmp_core::surface::Surface;
 use edmp_core::surface::bvh::{Node, build, nodes_for};
 use edmp_core::surface::element::{Element, SurfaceError};
@@ -63,6 +64,8 @@ pub struct Surfaces {
     pub points_filtered: usize,
     /// Per reduced cloud (its obstacle index), how it was reduced.
     pub reduced: Vec<(usize, Reduced)>,
+    /// The boxes the guides see around the pieces ([`covers`]).
+    pub boxes: Vec<Obstacle>,
     pieces: Vec<Element>,
     nodes: Vec<Node>,
 }
@@ -354,11 +357,16 @@ pub fn build_surfaces(
         build(&mut pieces, &mut nodes).map_err(|e| surface_error(e, "obstacles"))?
     };
     nodes.truncate(used);
-    Ok(Surfaces {
+    let mut surfaces = Surfaces {
         obstacles,
         points_filtered,
         reduced,
+        boxes: Vec::new(),
         pieces,
         nodes,
-    })
+    };
+    let mut boxes = [Obstacle::PLACEHOLDER; SURFACE_BOXES];
+    let made = covers(&surfaces.surface(), &mut boxes);
+    surfaces.boxes = boxes[..made].to_vec();
+    Ok(surfaces)
 }
