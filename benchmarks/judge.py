@@ -24,7 +24,7 @@ the `panda_hand` link's world pose at every state.
 Point clouds and meshes (issue 33): a scene whose `meta.truth_obstacles` exists (the sets of
 benchmarks/cells.py: a cloud or mesh made from primitives) is judged against those true
 primitives, not against its `obstacles`. Otherwise a `points` obstacle is the union of balls
-of its `radius` (compound bodies of 2000 spheres), after dropping the points within
+of its `radius` (probed sphere by sphere near the robot, see Cloud), after dropping the points within
 `filter_robot` of any robot collision body (link0 included) at `start`, measured by
 `getClosestPoints` from a 0.1 mm probe sphere (PyBullet's ~1 mm hull margin makes this drop a
 little more, never less, than the exact hulls would); a `mesh` obstacle is a static concave
@@ -218,7 +218,6 @@ PLY_TYPES = {
     "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
     "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
 }
-POINT_CHUNK = 2000  # spheres per compound body of a `points` obstacle
 
 
 def read_ply(path: pathlib.Path) -> tuple[np.ndarray, np.ndarray | None]:
@@ -434,15 +433,80 @@ def near_robot(robot: Robot, points: np.ndarray, within: float) -> np.ndarray:
     return near
 
 
-def spawn_points(robot: Robot, points: np.ndarray, radius: float) -> list[int]:
-    """Balls of `radius` around the points: compound bodies of POINT_CHUNK spheres each."""
-    c = robot.client
-    bodies = []
-    for i in range(0, len(points), POINT_CHUNK):
-        chunk = points[i : i + POINT_CHUNK]
-        shape = p.createCollisionShapeArray([p.GEOM_SPHERE] * len(chunk), radii=[radius] * len(chunk), collisionFramePositions=chunk.tolist(), physicsClientId=c)
-        bodies.append(p.createMultiBody(0, shape, physicsClientId=c))
-    return bodies
+class Cloud:
+    """A `points` obstacle: the union of balls of `radius` around its points. PyBullet keeps
+    only the first 16 children of a compound shape (createCollisionShapeArray drops the rest
+    silently) and slows to seconds per body with thousands of bodies, so the balls are not
+    bodies: the points are binned into CELL-metre cells and two probe spheres are moved
+    instead. A cell's probe (centre of the cell's points, radius = their farthest + `radius`)
+    contains all its balls; only when it comes within reach of a robot link are the cell's
+    balls probed one by one (a sphere of `radius` at the point, the same query as a sphere
+    obstacle). The verdict is PyBullet's for every ball."""
+
+    CELL = 0.03
+
+    def __init__(self, robot: Robot, points: np.ndarray, radius: float) -> None:
+        self.robot, self.points, self.radius = robot, np.asarray(points, dtype=np.float64).reshape(-1, 3), radius
+        keys = np.floor(self.points / self.CELL).astype(np.int64)
+        order = np.lexsort(keys.T[::-1])
+        keys, self.points = keys[order], self.points[order]
+        starts = np.flatnonzero(np.r_[True, np.any(keys[1:] != keys[:-1], axis=1)]) if len(keys) else np.zeros(0, dtype=np.int64)
+        self.bounds = np.r_[starts, len(self.points)]
+        self.centers = np.array([self.points[a:b].mean(axis=0) for a, b in zip(self.bounds[:-1], self.bounds[1:])]).reshape(-1, 3)
+        self.reach = np.array([np.max(np.linalg.norm(self.points[a:b] - c, axis=1)) for a, b, c in zip(self.bounds[:-1], self.bounds[1:], self.centers)])
+        c = robot.client
+        self.probes: dict[float, int] = {}
+        self.ball = self.probe(radius)
+
+    def probe(self, r: float) -> int:
+        r = round(float(r), 6)
+        if r not in self.probes:
+            shape = p.createCollisionShape(p.GEOM_SPHERE, radius=r, physicsClientId=self.robot.client)
+            self.probes[r] = p.createMultiBody(0, shape, basePosition=[0, 0, -100], physicsClientId=self.robot.client)
+        return self.probes[r]
+
+    def _near(self, body: int, at: np.ndarray, within: float, other: int) -> tuple[float, int] | None:
+        """(distance, link) of the nearest link of `other` (the robot: links 1..; or the held
+        object) to the probe, if within."""
+        c = self.robot.client
+        p.resetBasePositionAndOrientation(body, at.tolist(), [0, 0, 0, 1], physicsClientId=c)
+        best = None
+        for pt in p.getClosestPoints(body, other, within, physicsClientId=c):
+            if (pt[4] != -1 or other != self.robot.body) and pt[8] <= within and (best is None or pt[8] < best[0]):
+                best = (pt[8], pt[4])
+        return best
+
+    def nearest(self, within: float, other: int | None = None) -> tuple[float, int] | None:
+        """(distance, link) of the nearest ball to the robot (links 1..) or to `other` (the
+        held object), if within `within` (0: contact)."""
+        robot, c = self.robot, self.robot.client
+        other = robot.body if other is None else other
+        if not len(self.centers):
+            return None
+        lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+        for link in robot.moving if other == robot.body else [-1]:
+            a, b = p.getAABB(other, link, physicsClientId=c)
+            lo, hi = np.minimum(lo, a), np.maximum(hi, b)
+        grow = self.reach[:, None] + self.radius + within + 0.002
+        cells = np.flatnonzero(np.all((self.centers + grow >= lo) & (self.centers - grow <= hi), axis=1))
+        best = None
+        for i in cells:
+            cap = self.reach[i] + self.radius
+            bound = within if best is None else min(within, best[0])
+            if self._near(self.probe(cap), self.centers[i], bound, other) is None:
+                continue
+            for k in range(self.bounds[i], self.bounds[i + 1]):
+                hit = self._near(self.ball, self.points[k], within if best is None else min(within, best[0]), other)
+                if hit is not None and (best is None or hit[0] < best[0]):
+                    best = hit
+                    if within <= 0.0:
+                        return best
+        return best
+
+    def remove(self) -> None:
+        for body in self.probes.values():
+            p.removeBody(body, physicsClientId=self.robot.client)
+        self.probes.clear()
 
 
 def spawn_mesh(robot: Robot, vertices: np.ndarray, triangles: np.ndarray) -> int:
@@ -461,18 +525,17 @@ def judged_obstacles(scene: dict[str, Any]) -> list[dict[str, Any]]:
     return scene.get("obstacles", [])
 
 
-def spawn_scene(robot: Robot, scene: dict[str, Any], base: pathlib.Path | None) -> list[tuple[int, int]]:
-    """(obstacle index, body) for every body of the judged obstacles; a `points` obstacle is
-    several bodies. `filter_robot` drops points near the robot at `start` (fingers at the
-    scene's opening)."""
-    out: list[tuple[int, int]] = []
+def spawn_scene(robot: Robot, scene: dict[str, Any], base: pathlib.Path | None) -> list[tuple[int, Any]]:
+    """(obstacle index, body or Cloud) for every judged obstacle. `filter_robot` drops points
+    near the robot at `start` (fingers at the scene's opening)."""
+    out: list[tuple[int, Any]] = []
     for k, o in enumerate(judged_obstacles(scene)):
         if o["type"] == "points":
             points = cloud_points(o, base)
             if o.get("filter_robot"):
                 set_state(robot, np.asarray(scene["start"], dtype=np.float64))
                 points = points[~near_robot(robot, points, float(o["filter_robot"]))]
-            out += [(k, b) for b in spawn_points(robot, points, float(o["radius"]))]
+            out.append((k, Cloud(robot, points, float(o["radius"]))))
         elif o["type"] == "mesh":
             out.append((k, spawn_mesh(robot, *mesh_triangles(o, base))))
         else:
@@ -507,8 +570,9 @@ def link_pose(robot: Robot, link: int) -> tuple[tuple[float, ...], tuple[float, 
     return state[4], state[5]
 
 
-def closest(c: int, a: int, b: int, within: float, link_a: int | None = None, link_b: int | None = None) -> float | None:
-    """Smallest getClosestPoints distance <= `within` between two bodies (links), else None."""
+def closest(c: int, a: int, b: Any, within: float, link_a: int | None = None, link_b: int | None = None) -> float | None:
+    """Smallest getClosestPoints distance <= `within` between two bodies (links), else None.
+    (Clouds are queried through Cloud.nearest.)"""
     kwargs = {}
     if link_a is not None:
         kwargs["linkIndexA"] = link_a
@@ -535,6 +599,11 @@ def queries(robot: Robot, obstacles: list[int], held: int | None, indices: list[
     out: list[tuple[int, int, int | None, int | None, dict[str, Any]]] = []
     for i, obstacle in enumerate(obstacles):
         k = indices[i] if indices is not None else i
+        if isinstance(obstacle, Cloud):  # one entry: it answers for every moving link
+            out.append((robot.body, obstacle, None, None, {"kind": "obstacle", "link": "", "obstacle": k}))
+            if held is not None:
+                out.append((held, obstacle, None, None, {"kind": "obstacle", "link": HELD, "obstacle": k}))
+            continue
         for link in robot.moving:
             out.append((robot.body, obstacle, link, None, {"kind": "obstacle", "link": robot.names[link], "obstacle": k}))
         if held is not None:
@@ -551,6 +620,11 @@ def contact_at(robot: Robot, q: np.ndarray, pairs: list, held: int | None, held_
     """The first contact (distance <= 0) found at configuration q, or None."""
     place(robot, q, held, held_pose)
     for a, b, link_a, link_b, what in pairs:
+        if isinstance(b, Cloud):
+            hit = b.nearest(0.0, a)
+            if hit is not None:
+                return what | {"link": robot.names[hit[1]] if a == robot.body else HELD, "distance": hit[0]}
+            continue
         d = closest(robot.client, a, b, 0.0, link_a, link_b)
         if d is not None:
             return what | {"distance": d}
@@ -562,6 +636,11 @@ def nearest_at(robot: Robot, q: np.ndarray, pairs: list, held: int | None, held_
     place(robot, q, held, held_pose)
     best: dict[str, Any] | None = None
     for a, b, link_a, link_b, what in pairs:
+        if isinstance(b, Cloud):
+            hit = b.nearest(within, a)
+            if hit is not None and (best is None or hit[0] < best["distance"]):
+                best = what | {"link": robot.names[hit[1]] if a == robot.body else HELD, "distance": hit[0]}
+            continue
         d = closest(robot.client, a, b, within, link_a, link_b)
         if d is not None and (best is None or d < best["distance"]):
             best = what | {"distance": d}
@@ -662,7 +741,10 @@ def walk(robot: Robot, scene: dict[str, Any], w: np.ndarray, query: Any, base: p
                 yield segment, step, len(along), query(robot, q, pairs, held, held_pose, **kwargs)
     finally:
         for body in obstacles + ([held] if held is not None else []):
-            p.removeBody(body, physicsClientId=robot.client)
+            if isinstance(body, Cloud):
+                body.remove()
+            else:
+                p.removeBody(body, physicsClientId=robot.client)
 
 
 def clearance(robot: Robot, scene: dict[str, Any], waypoints: Any, within: float = 0.01, base: pathlib.Path | None = None) -> dict[str, Any] | None:
