@@ -307,3 +307,144 @@ def test_a_bad_gripper_is_bad_input(robot, tmp_path):
     write(problems / "cubby" / "003.json", SCENE | {"gripper": {"finger": 0.05}})
     write(plans / "cubby" / "003.json", PLAN)
     assert judge.main(["--problems", str(problems), "--plans", str(plans), "--jobs", "1", "--no-progress"]) == 2
+
+
+# ---- point-cloud and mesh obstacles (issue 33) ----------------------------------------------
+
+
+def tip_at_ready(robot, along: float = 0.05) -> list[float]:
+    """A point `along` metres out of the hand at the ready pose (between the fingers' tips)."""
+    judge.set_state(robot, np.array(READY))
+    hand_pos, hand_quat = judge.link_pose(robot, robot.hand)
+    point, _ = judge.p.multiplyTransforms(hand_pos, hand_quat, [0, 0, along], [0, 0, 0, 1])
+    return list(point)
+
+
+def little_cloud(center: list[float], half: float = 0.02, step: float = 0.01) -> list[list[float]]:
+    g = np.arange(-half, half + 1e-9, step)
+    return (np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3) + center).tolist()
+
+
+CUBE_V = [[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+CUBE_T = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]
+
+
+def distance_at_ready(robot, point: list[float]) -> float:
+    """PyBullet's distance from a point to the robot at the ready pose (0.1 mm probe sphere)."""
+    probe = judge.spawn(robot, {"type": "sphere", "center": point, "radius": 1e-4})
+    try:
+        judge.set_state(robot, np.array(READY))
+        judge.p.performCollisionDetection(physicsClientId=robot.client)
+        return judge.closest(robot.client, robot.body, probe, 1.0) + 1e-4
+    finally:
+        judge.p.removeBody(probe, physicsClientId=robot.client)
+
+
+def test_a_point_cloud_touches_or_not(robot):
+    # A 5 x 5 x 5 cloud 20 cm out of the hand and one point 12 cm out (1.5 cm beyond the TCP,
+    # about 25 mm from the fingertips): the balls touch when their radius exceeds that distance.
+    point = tip_at_ready(robot, 0.12)
+    d = distance_at_ready(robot, point)
+    assert 0.015 < d < 0.04
+    points = little_cloud(tip_at_ready(robot, 0.20)) + [point]
+    for radius, failed in ((d + 0.001, ["contact"]), (d - 0.001, [])):
+        v = judge.judge(robot, empty_scene(READY, READY, [{"type": "points", "points": points, "radius": radius}]), {"waypoints": constant(READY)})
+        assert v["failed"] == failed, (radius, v)
+    v = judge.judge(robot, empty_scene(READY, READY, [{"type": "points", "points": points, "radius": d + 0.001}]), {"waypoints": constant(READY)})
+    assert v["first_contact"]["obstacle"] == 0 and v["first_contact"]["link"] in ("panda_leftfinger", "panda_rightfinger")
+    # Placed: the same points in the frame of `center` / `quaternion` (a quarter turn about z
+    # around the base): where they land decides.
+    turn = [math.cos(math.pi / 4), 0, 0, math.sin(math.pi / 4)]
+    local = (np.asarray(points) @ judge.rotation(turn)).tolist()  # R^T p: rotated back by R
+    placed = {"type": "points", "points": local, "radius": d + 0.001, "center": [0, 0, 0], "quaternion": turn}
+    assert judge.judge(robot, empty_scene(READY, READY, [placed]), {"waypoints": constant(READY)})["failed"] == ["contact"]
+    assert judge.judge(robot, empty_scene(READY, READY, [placed | {"quaternion": [1, 0, 0, 0]}]), {"waypoints": constant(READY)})["solved"]
+    assert judge.p.getNumBodies(physicsClientId=robot.client) == 1
+
+
+def test_filter_robot_drops_the_points_on_the_arm_at_start(robot):
+    # A 16 cm cloud around the flange (as a camera sees the arm): in contact, unless
+    # filter_robot drops the points within 2 cm of the robot, which leaves the rest free.
+    on_arm = little_cloud(tip_at_ready(robot, 0.0), half=0.08, step=0.02)
+    cloud = {"type": "points", "points": on_arm, "radius": 0.0075}
+    assert judge.judge(robot, empty_scene(READY, READY, [cloud]), {"waypoints": constant(READY)})["failed"] == ["contact"]
+    assert judge.judge(robot, empty_scene(READY, READY, [cloud | {"filter_robot": 0.02}]), {"waypoints": constant(READY)})["solved"]
+    assert judge.judge(robot, empty_scene(READY, READY, [cloud | {"filter_robot": 0.005}]), {"waypoints": constant(READY)})["failed"] == ["contact"]
+    judge.set_state(robot, np.array(READY))
+    near = judge.near_robot(robot, np.asarray(on_arm), 0.02)
+    assert 0 < near.sum() < len(on_arm)
+    # Exactly the points whose distance to the robot (link0 included) is within 2 cm.
+    assert np.array_equal(near, np.array([distance_at_ready(robot, q) <= 0.02 for q in on_arm]))
+
+
+def test_a_mesh_touches_or_not_like_the_box_it_draws(robot, tmp_path):
+    # A cube mesh and the same cuboid primitive out of the hand: PyBullet's closest approach
+    # agrees within 1 mm, and the judge calls both in contact when they reach the fingers
+    # (6 cm cube, 13 cm out), both free when they do not (4 cm cube, 16 cm out).
+    cases = ((tip_at_ready(robot, 0.13), 0.03, ["contact"]), (tip_at_ready(robot, 0.16), 0.02, []))
+    for center, half, failed in cases:
+        cube = {"type": "mesh", "vertices": CUBE_V, "triangles": CUBE_T, "center": center, "scale": half}
+        box = {"type": "cuboid", "center": center, "dims": [2 * half] * 3, "quaternion": [1, 0, 0, 0]}
+        verdicts = [judge.judge(robot, empty_scene(READY, READY, [o]), {"waypoints": constant(READY)}) for o in (cube, box)]
+        assert [v["failed"] for v in verdicts] == [failed, failed], half
+        if not failed:
+            near = [judge.clearance(robot, empty_scene(READY, READY, [o]), constant(READY)[:1], 0.05)["distance"] for o in (cube, box)]
+            assert abs(near[0] - near[1]) < 0.001, near
+    # The same cube from OBJ, STL (binary and ASCII) and PLY files next to the scene.
+    v, t = np.asarray(CUBE_V, dtype=np.float64), np.asarray(CUBE_T)
+    (tmp_path / "c.obj").write_text("".join(f"v {a} {b} {c}\n" for a, b, c in v) + "vt 0 0\n" + "".join(f"f {a + 1}/1 {b + 1}/1 {c + 1}/1\n" for a, b, c in t))
+    rec = np.zeros(len(t), np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))
+    rec["v"] = v[t]
+    (tmp_path / "c.stl").write_bytes(b"solid binary".ljust(80) + np.uint32(len(t)).tobytes() + rec.tobytes())
+    (tmp_path / "a.stl").write_text("solid a\n" + "".join("facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x} {y} {z}\n" for x, y, z in v[f]) + "endloop\nendfacet\n" for f in t) + "endsolid a\n")
+    header = f"ply\nformat ascii 1.0\nelement vertex {len(v)}\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\nelement face {len(t)}\nproperty list uchar int vertex_indices\nend_header\n"
+    (tmp_path / "c.ply").write_text(header + "".join(f"{a} {b} {c} 255\n" for a, b, c in v) + "".join(f"3 {a} {b} {c}\n" for a, b, c in t))
+    for name in ("c.obj", "c.stl", "a.stl", "c.ply"):
+        read_v, read_t = judge.read_mesh(tmp_path / name)
+        assert np.allclose(np.sort(read_v[read_t].reshape(-1, 3), axis=0), np.sort(v[t].reshape(-1, 3), axis=0)), name
+        for center, half, failed in cases:
+            scene = empty_scene(READY, READY, [{"type": "mesh", "file": name, "center": center, "quaternion": [1, 0, 0, 0], "scale": [half] * 3}])
+            assert judge.judge(robot, scene, {"waypoints": constant(READY)}, tmp_path)["failed"] == failed, name
+    # An open mesh is its surface: the cube's two triangles of one face, across the fingers.
+    judge.set_state(robot, np.array(READY))
+    _, hand_quat = judge.link_pose(robot, robot.hand)
+    x, y, z, w = hand_quat
+    face = {"type": "mesh", "vertices": CUBE_V, "triangles": CUBE_T[:2], "center": tip_at_ready(robot, 0.10), "quaternion": [w, x, y, z], "scale": [0.005, 0.05, 0.01]}
+    assert judge.judge(robot, empty_scene(READY, READY, [face]), {"waypoints": constant(READY)})["failed"] == ["contact"]
+    thin = face | {"scale": [0.005, 0.01, 0.01]}  # the same plate, too narrow to reach the fingers
+    assert judge.judge(robot, empty_scene(READY, READY, [thin]), {"waypoints": constant(READY)})["solved"]
+
+
+def test_point_files_ply_and_pcd(tmp_path):
+    pts = np.random.default_rng(0).uniform(-1, 1, (50, 3))
+    (tmp_path / "b.ply").write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 50\nproperty float x\nproperty float y\nproperty float z\nproperty double intensity\nend_header\n" + np.rec.fromarrays([*pts.T.astype("<f4"), np.zeros(50)], dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("i", "<f8")]).tobytes())
+    (tmp_path / "a.pcd").write_text("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 50\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 50\nDATA ascii\n" + "".join(f"{a} {b} {c} 7\n" for a, b, c in pts))
+    rows = np.rec.fromarrays([*pts.T], dtype=[("x", "<f8"), ("y", "<f8"), ("z", "<f8")]).tobytes()
+    (tmp_path / "b.pcd").write_bytes(b"VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 50\nHEIGHT 1\nDATA binary\n" + rows)
+    for name in ("b.ply", "a.pcd", "b.pcd"):
+        assert np.allclose(judge.read_points(tmp_path / name), pts, atol=1e-6), name
+
+
+def test_truth_obstacles_replace_the_scenes_obstacles(robot, tmp_path):
+    tip = tip_at_ready(robot, 0.06)  # inside the hand
+    touching = {"type": "points", "points": little_cloud(tip), "radius": 0.0075}
+    sphere = {"type": "sphere", "center": tip, "radius": 0.02}
+    # The cloud would touch; the truth is empty: solved, and the verdict says what it judged.
+    scene = empty_scene(READY, READY, [touching]) | {"meta": {"truth_obstacles": []}}
+    v = judge.judge(robot, scene, {"waypoints": constant(READY)})
+    assert v["solved"] and v["judged_against"] == "meta.truth_obstacles"
+    # The scene's cloud is far away; the truth touches.
+    far = {"type": "points", "points": [[2.0, 2.0, 2.0]], "radius": 0.0075}
+    scene = empty_scene(READY, READY, [far]) | {"meta": {"truth_obstacles": [sphere]}}
+    v = judge.judge(robot, scene, {"waypoints": constant(READY)})
+    assert v["failed"] == ["contact"] and v["first_contact"]["obstacle"] == 0
+    assert "judged_against" not in judge.judge(robot, empty_scene(READY, READY, [sphere]), {"waypoints": constant(READY)})
+    # From the command line, a file beside the problem: resolved against the problem's folder.
+    problems = tmp_path / "problems"
+    write(problems / "cells" / "000.json", empty_scene(READY, READY, [{"type": "mesh", "file": "000.obj", "center": tip, "scale": 0.02}]))
+    (problems / "cells" / "000.obj").write_text("".join(f"v {a} {b} {c}\n" for a, b, c in CUBE_V) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in CUBE_T))
+    run = tmp_path / "results.jsonl"
+    run.write_text(json.dumps({"problem": "cells/000.json", "planner": "x", "status": "success", "waypoints": constant(READY)}) + "\n")
+    assert judge.main(["--problems", str(problems), "--results", str(run), "--jobs", "1", "--no-progress"]) == 1
+    (problems / "cells" / "000.obj").unlink()
+    assert judge.main(["--problems", str(problems), "--results", str(run), "--jobs", "1", "--no-progress"]) == 2
