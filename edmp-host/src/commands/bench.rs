@@ -102,6 +102,10 @@ pub struct Record {
     pub status: String,
     /// Planning time, milliseconds (IK + denoising + selection, or the whole RRT search).
     pub time_ms: f64,
+    /// Reading the problem, milliseconds: the scene's JSON and the cloud and mesh files it
+    /// names, parsed, filtered, reduced and built into the planner's hierarchy.
+    #[serde(default)]
+    pub read_ms: f64,
     /// Joint-space length of the returned path (radians; absent without a path).
     pub path_length: Option<f64>,
     /// Roughness of the returned path.
@@ -157,7 +161,9 @@ fn label(args: &Args, guides: &[u8]) -> String {
 }
 
 fn run_edmp(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record, Failure> {
+    let reading = std::time::Instant::now();
     let parsed = parse_problem_in(text, dir).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
+    let read_ms = reading.elapsed().as_secs_f64() * 1e3;
     let guides = args.tuning.guides(&args.guides)?;
     let config = args.tuning.config()?;
     let planned = plan_problem_on(&parsed, &guides, &config, args.seed, args.tuning.threads()?)?;
@@ -203,6 +209,7 @@ fn run_edmp(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record
         serial: args.serial,
         status: if plan.is_free() { "success" } else { "collision" }.to_owned(),
         time_ms: planned.total_ms(),
+        read_ms,
         path_length: Some(path_length(best)),
         roughness: Some(roughness(best)),
         guide: Some(guides[plan.best / per_guide].id),
@@ -216,7 +223,9 @@ fn run_edmp(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record
 }
 
 fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record, Failure> {
+    let reading = std::time::Instant::now();
     let parsed = parse_problem_in(text, dir).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
+    let read_ms = reading.elapsed().as_secs_f64() * 1e3;
     let goal = match parsed.goal {
         Goal::Joints(q) => q,
         Goal::Pose { .. } => crate::formats::json::joint_goal(&parsed).map_err(Failure::Input)?,
@@ -253,6 +262,7 @@ fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record,
         serial: args.serial,
         status: status.to_owned(),
         time_ms,
+        read_ms,
         path_length: (!waypoints.is_empty()).then(|| path_length(&waypoints)),
         roughness: (!waypoints.is_empty()).then(|| roughness(&waypoints)),
         guide: None,
@@ -537,6 +547,7 @@ mod tests {
             serial: true,
             status: "success".to_owned(),
             time_ms,
+            read_ms: 0.0,
             path_length: None,
             roughness: None,
             guide: None,
