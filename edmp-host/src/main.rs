@@ -34,7 +34,7 @@ enum Command {
     BenchRrt(bench_rrt::Args),
     /// Generate training trajectories (RRT-Connect in generated scenes) as a `.npy` file.
     GenData(gen_data::Args),
-    /// Draw a scene (and optionally a plan) as a PNG: top and side views.
+    /// Draw a scene (and optionally a plan) as a PNG: top, side and front views.
     Render(render::Args),
     /// Measure the unguided diffusion prior: roughness, joint limits, self-collision, time.
     Sample(sample::Args),

@@ -102,6 +102,16 @@ fn render_writes_a_png_of_the_scene_and_of_a_plan_with_its_candidates() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(size(&png), (1800, 600));
     assert_ne!(std::fs::read(&png).unwrap(), bare, "the plan is drawn");
+    // A cloud (PLY) and a mesh (OBJ) read beside the scene (where they are drawn: the unit
+    // tests of commands/render.rs).
+    let out = edmp_host(&[
+        "render",
+        "edmp-host/tests/data/surfaces.json",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(size(&png), (1800, 600));
     std::fs::remove_dir_all(&dir).ok();
 }
 

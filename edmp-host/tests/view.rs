@@ -144,6 +144,8 @@ struct Shot {
     load_ms: f64,
     /// RGB rows of the screenshot.
     rgb: Vec<u8>,
+    /// The `<body>` tag with its `data-` attributes.
+    body: String,
 }
 
 fn chromium(dir: &Path, page: &Path, fragment: &str, extra: &str) -> std::process::Output {
@@ -226,6 +228,7 @@ fn shoot(dir: &Path, page: &Path, fraction: f64) -> Shot {
         pixel: numbers(attribute(body, "data-tcp-px").unwrap()),
         load_ms: attribute(body, "data-load-ms").unwrap().parse().unwrap(),
         rgb,
+        body: body.to_string(),
     }
 }
 
@@ -336,5 +339,44 @@ fn chromium_draws_the_arm_where_the_kinematics_put_it() {
             shot.pixel
         );
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn chromium_draws_the_clouds_and_meshes() {
+    if !Path::new(CHROMIUM).exists() {
+        assert_ne!(
+            std::env::var("CI").as_deref(),
+            Ok("true"),
+            "{CHROMIUM} is missing under CI: scripts/test installs it (apt-get install chromium)"
+        );
+        println!("note: {CHROMIUM} not found, the browser check is skipped (apt-get install chromium)");
+        return;
+    }
+    let dir = scratch("surfaces");
+    // A 400-point cloud (PLY) and a 12-triangle cube (OBJ), with a small sphere: the orange
+    // of the obstacles is mostly the cloud's and the cube's.
+    let page = dir.join("surfaces.html");
+    let out = edmp_host(&[
+        "view",
+        "edmp-host/tests/data/surfaces.json",
+        "-o",
+        page.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let shot = shoot(&dir, &page, 0.0);
+    assert_eq!(attribute(&shot.body, "data-cloud-points"), Some("400"), "{}", shot.body);
+    assert_eq!(
+        attribute(&shot.body, "data-mesh-triangles"),
+        Some("12"),
+        "{}",
+        shot.body
+    );
+    let orange = orange_pixels(&shot.rgb);
+    println!("{orange} orange (obstacle) pixels");
+    assert!(
+        orange > 6000,
+        "the cloud and the cube drawn: only {orange} orange pixels"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -4,10 +4,15 @@
 //! trajectory, and the path of the TCP in dark red. `--candidates` overlays the TCP path of
 //! every candidate of the ensemble (plans written with `edmp-host plan --candidates`): one
 //! colour per collision-free candidate, grey for colliding ones.
+//! Clouds (`points` obstacles) and meshes are grey too: each cloud as a dot of its ball radius
+//! per point (every k-th point when it has more than [`MAX_DRAWN_POINTS`]), each mesh as its
+//! triangles, flat shaded; depth-tested within the obstacle, which is then blended once, as
+//! translucent as a primitive.
 //! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
 
-use crate::formats::json::{Goal, parse_problem_in};
-use crate::formats::plan::parse_plan;
+use crate::formats::json::{Goal, Problem, parse_problem_in};
+use crate::formats::plan::{PlanDocument, parse_plan};
+use crate::formats::surface::SurfaceKind;
 use edmp_core::collision::convex::{Convex, Solid};
 use edmp_core::robot::kinematics::{Joints, forward, forward_with};
 use edmp_core::robot::{BODIES, PANDA};
@@ -35,6 +40,17 @@ const PANEL: usize = 600;
 const X_RANGE: [f32; 2] = [-0.5, 1.4];
 const Y_RANGE: [f32; 2] = [-0.95, 0.95];
 const Z_RANGE: [f32; 2] = [-0.15, 1.75];
+
+/// The most points of one cloud drawn: a larger cloud is drawn every k-th point (k the
+/// smallest that fits), in the file's order.
+pub const MAX_DRAWN_POINTS: usize = 20_000;
+
+/// Colour of the obstacles, and its opacity.
+const OBSTACLE: [f32; 3] = [0.35, 0.35, 0.38];
+const OBSTACLE_ALPHA: f32 = 0.45;
+/// Colours of a cloud's or mesh's surface turned away from the light and facing it.
+const SURFACE_DARK: [f32; 3] = [0.22, 0.22, 0.25];
+const SURFACE_LIGHT: [f32; 3] = [0.52, 0.52, 0.55];
 
 /// The three panels, left to right: top (x right, y up), side (x right, z up), front (seen
 /// from +x: y right, z up).
@@ -197,15 +213,210 @@ fn outline(p: &Solid) -> Vec<Vector3<f32>> {
     out
 }
 
+impl View {
+    fn panel(self) -> usize {
+        match self {
+            View::Top => 0,
+            View::Side => 1,
+            View::Front => 2,
+        }
+    }
+
+    /// World directions of the panel's right and up, and towards the viewer.
+    fn axes(self) -> [Vector3<f32>; 3] {
+        match self {
+            View::Top => [Vector3::x(), Vector3::y(), Vector3::z()],
+            View::Side => [Vector3::x(), Vector3::z(), -Vector3::y()],
+            View::Front => [Vector3::y(), Vector3::z(), Vector3::x()],
+        }
+    }
+
+    /// Where the light comes from: towards the viewer, from the upper left.
+    fn light(self) -> Vector3<f32> {
+        let [right, up, out] = self.axes();
+        (out + 0.6 * up - 0.4 * right).normalize()
+    }
+}
+
+/// Pixels per metre (the three windows are equally wide).
+const SCALE: f32 = PANEL as f32 / (X_RANGE[1] - X_RANGE[0]);
+
+/// Pixel of world point `p` within its view's panel, and its depth (metres, away from the
+/// viewer).
+fn panel_pixel(p: &Vector3<f32>, view: View) -> [f32; 3] {
+    let scale = |x: f32, range: [f32; 2]| (x - range[0]) / (range[1] - range[0]) * PANEL as f32;
+    let (u, v, depth) = match view {
+        View::Top => (scale(p.x, X_RANGE), scale(p.y, Y_RANGE), -p.z),
+        View::Side => (scale(p.x, X_RANGE), scale(p.z, Z_RANGE), p.y),
+        View::Front => (scale(p.y, Y_RANGE), scale(p.z, Z_RANGE), -p.x),
+    };
+    [u, PANEL as f32 - v, depth]
+}
+
 /// Pixel of world point `p` in a view, with the panel offset.
 fn pixel(p: &Vector3<f32>, view: View) -> [f32; 2] {
-    let scale = |x: f32, range: [f32; 2]| (x - range[0]) / (range[1] - range[0]) * PANEL as f32;
-    let (u, v, panel) = match view {
-        View::Top => (scale(p.x, X_RANGE), scale(p.y, Y_RANGE), 0),
-        View::Side => (scale(p.x, X_RANGE), scale(p.z, Z_RANGE), 1),
-        View::Front => (scale(p.y, Y_RANGE), scale(p.z, Z_RANGE), 2),
-    };
-    [u + (panel * PANEL) as f32, PANEL as f32 - v]
+    let [u, v, _] = panel_pixel(p, view);
+    [u + (view.panel() * PANEL) as f32, v]
+}
+
+fn mix(a: [f32; 3], b: [f32; 3], s: f32) -> [f32; 3] {
+    let s = s.clamp(0.0, 1.0);
+    [0, 1, 2].map(|c| a[c] + s * (b[c] - a[c]))
+}
+
+/// One obstacle in one panel: the nearest surface's colour and depth per pixel, so that the
+/// obstacle is blended onto the canvas once however many of its pieces overlap.
+struct Layer {
+    view: View,
+    depth: Vec<f32>,
+    colour: Vec<[f32; 3]>,
+}
+
+impl Layer {
+    fn new(view: View) -> Self {
+        Self {
+            view,
+            depth: vec![f32::INFINITY; PANEL * PANEL],
+            colour: vec![[0.0; 3]; PANEL * PANEL],
+        }
+    }
+
+    /// Sets pixel (x, y) of the panel to `colour` if `depth` is nearer than what it holds.
+    fn put(&mut self, x: i64, y: i64, depth: f32, colour: [f32; 3]) {
+        if !(0..PANEL as i64).contains(&x) || !(0..PANEL as i64).contains(&y) {
+            return;
+        }
+        let k = y as usize * PANEL + x as usize;
+        if depth < self.depth[k] {
+            self.depth[k] = depth;
+            self.colour[k] = colour;
+        }
+    }
+
+    /// A ball of `radius` pixels (at least one pixel) around `centre`, shaded as a sphere.
+    fn ball(&mut self, centre: [f32; 3], radius: f32) {
+        let light = {
+            let [right, up, out] = self.view.axes();
+            let l = self.view.light();
+            Vector3::new(l.dot(&right), l.dot(&up), l.dot(&out))
+        };
+        // At least one pixel: the nearest pixel centre is within 0.71 of any point.
+        let r = radius.max(1.0);
+        let (x0, x1) = ((centre[0] - r).floor() as i64, (centre[0] + r).ceil() as i64);
+        let (y0, y1) = ((centre[1] - r).floor() as i64, (centre[1] + r).ceil() as i64);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let (dx, dy) = (x as f32 - centre[0], centre[1] - y as f32);
+                let d2 = dx * dx + dy * dy;
+                if d2 > r * r {
+                    continue;
+                }
+                let dz = (r * r - d2).max(0.0).sqrt();
+                let normal = Vector3::new(dx, dy, dz) / r;
+                let colour = mix(SURFACE_DARK, SURFACE_LIGHT, normal.dot(&light));
+                self.put(x, y, centre[2] - dz / SCALE, colour);
+            }
+        }
+    }
+
+    /// A triangle (world corners), flat shaded, its edges drawn too so that one seen edge-on
+    /// is still a line.
+    fn triangle(&mut self, corners: [Vector3<f32>; 3]) {
+        let normal = (corners[1] - corners[0]).cross(&(corners[2] - corners[0]));
+        let norm = normal.norm();
+        if norm.is_nan() || norm <= 0.0 {
+            return;
+        }
+        // Both sides lit alike: meshes need not be closed nor consistently wound.
+        let colour = mix(
+            SURFACE_DARK,
+            SURFACE_LIGHT,
+            (normal / norm).dot(&self.view.light()).abs(),
+        );
+        let p = corners.map(|c| panel_pixel(&c, self.view));
+        let edge = |a: [f32; 3], b: [f32; 3], x: f32, y: f32| (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+        let area = edge(p[0], p[1], p[2][0], p[2][1]);
+        if area.abs() > 1e-6 {
+            let lo = |k: usize| p.iter().map(|q| q[k]).fold(f32::INFINITY, f32::min).floor().max(0.0) as i64;
+            let hi = |k: usize| {
+                p.iter()
+                    .map(|q| q[k])
+                    .fold(f32::NEG_INFINITY, f32::max)
+                    .ceil()
+                    .min(PANEL as f32 - 1.0) as i64
+            };
+            for y in lo(1)..=hi(1) {
+                for x in lo(0)..=hi(0) {
+                    let (xf, yf) = (x as f32, y as f32);
+                    let w = [
+                        edge(p[1], p[2], xf, yf) / area,
+                        edge(p[2], p[0], xf, yf) / area,
+                        edge(p[0], p[1], xf, yf) / area,
+                    ];
+                    if w.iter().all(|&wk| wk >= 0.0) {
+                        self.put(x, y, w[0] * p[0][2] + w[1] * p[1][2] + w[2] * p[2][2], colour);
+                    }
+                }
+            }
+        }
+        for k in 0..3 {
+            let (a, b) = (p[k], p[(k + 1) % 3]);
+            let steps = (b[0] - a[0])
+                .abs()
+                .max((b[1] - a[1]).abs())
+                .ceil()
+                .clamp(1.0, 4.0 * PANEL as f32) as usize;
+            for i in 0..=steps {
+                let s = i as f32 / steps as f32;
+                let q = [0, 1, 2].map(|c| a[c] + s * (b[c] - a[c]));
+                self.put(q[0].round() as i64, q[1].round() as i64, q[2], colour);
+            }
+        }
+    }
+
+    /// Blends what the layer holds onto its panel of the canvas.
+    fn blend(&self, canvas: &mut Canvas, alpha: f32) {
+        let offset = self.view.panel() * PANEL;
+        for y in 0..PANEL {
+            for x in 0..PANEL {
+                let k = y * PANEL + x;
+                if self.depth[k].is_finite() {
+                    let p = &mut canvas.pixels[y * canvas.width + offset + x];
+                    *p = mix(*p, self.colour[k], alpha);
+                }
+            }
+        }
+    }
+}
+
+/// Every `stride`-th point of a cloud, `stride` the smallest that draws at most `max`.
+fn thinned(points: &[[f32; 3]], max: usize) -> impl Iterator<Item = &[f32; 3]> {
+    points.iter().step_by(points.len().div_ceil(max.max(1)).max(1))
+}
+
+/// The scene's clouds and meshes, in every view.
+fn draw_surfaces(canvas: &mut Canvas, problem: &Problem) {
+    for o in &problem.surfaces.obstacles {
+        for view in VIEWS {
+            let mut layer = Layer::new(view);
+            match &o.kind {
+                SurfaceKind::Points { points, radius, .. } => {
+                    for p in thinned(points, MAX_DRAWN_POINTS) {
+                        layer.ball(panel_pixel(&Vector3::from(*p), view), radius * SCALE);
+                    }
+                }
+                SurfaceKind::Mesh { vertices, triangles } => {
+                    for t in triangles {
+                        let corner = |i: u32| vertices.get(i as usize).map(|&v| Vector3::from(v));
+                        if let (Some(a), Some(b), Some(c)) = (corner(t[0]), corner(t[1]), corner(t[2])) {
+                            layer.triangle([a, b, c]);
+                        }
+                    }
+                }
+            }
+            layer.blend(canvas, OBSTACLE_ALPHA);
+        }
+    }
 }
 
 fn draw(canvas: &mut Canvas, points: &[Vector3<f32>], color: [f32; 3], alpha: f32) {
@@ -245,7 +456,7 @@ fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, finger: f32, color: [f32; 3]
     Ok(())
 }
 
-/// Draws the scene (and plan) and writes the PNG.
+/// Reads the scene (and plan), draws them and writes the PNG.
 pub fn run(args: &Args) -> Result<(), String> {
     let text = std::fs::read_to_string(&args.scene).map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let dir = args.scene.parent().unwrap_or(std::path::Path::new("."));
@@ -257,6 +468,11 @@ pub fn run(args: &Args) -> Result<(), String> {
         }
         None => None,
     };
+    picture(&problem, plan.as_ref(), args.candidates)?.png(&args.output)
+}
+
+/// The three views of `problem` (and `plan`, its candidates' paths with `candidates`).
+fn picture(problem: &Problem, plan: Option<&PlanDocument>, candidates: bool) -> Result<Canvas, String> {
     let mut canvas = Canvas::new(VIEWS.len() * PANEL, PANEL);
     // Panel frames and the floor line of the side and front views.
     for panel in 1..VIEWS.len() {
@@ -284,10 +500,11 @@ pub fn run(args: &Args) -> Result<(), String> {
         );
     }
     for o in problem.scene().obstacles() {
-        draw(&mut canvas, &outline(&Solid::obstacle(o)), [0.35, 0.35, 0.38], 0.45);
+        draw(&mut canvas, &outline(&Solid::obstacle(o)), OBSTACLE, OBSTACLE_ALPHA);
     }
+    draw_surfaces(&mut canvas, problem);
     let finger = problem.scene().gripper();
-    let path = plan.as_ref().map(|p| &p.waypoints);
+    let path = plan.map(|p| &p.waypoints);
     if let Some(path) = &path {
         let n = path.len().max(1);
         for (i, q) in path.iter().enumerate().step_by(4) {
@@ -304,9 +521,8 @@ pub fn run(args: &Args) -> Result<(), String> {
     if let Goal::Joints(goal) = problem.goal {
         draw_robot(&mut canvas, &goal, finger, [0.1, 0.65, 0.25], 0.35)?;
     }
-    if args.candidates {
+    if candidates {
         let list = plan
-            .as_ref()
             .map(|p| &p.candidates)
             .filter(|c| !c.is_empty())
             .ok_or("--candidates: the plan has no candidates (write it with `edmp-host plan --candidates`)")?;
@@ -324,5 +540,103 @@ pub fn run(args: &Args) -> Result<(), String> {
     if let Some(path) = &path {
         draw_tcp_path(&mut canvas, path, 3.5, [0.6, 0.05, 0.05], 0.95)?;
     }
-    canvas.png(&args.output)
+    Ok(canvas)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::json::parse_problem_in;
+
+    #[test]
+    fn a_large_cloud_is_drawn_every_kth_point_within_the_bound() {
+        let cloud: Vec<[f32; 3]> = (0..60_001).map(|i| [i as f32, 0.0, 0.0]).collect();
+        let drawn: Vec<_> = thinned(&cloud, MAX_DRAWN_POINTS).collect();
+        assert_eq!(drawn.len(), 15_001, "every 4th point");
+        assert_eq!((drawn[1][0], drawn[15_000][0]), (4.0, 60_000.0));
+        assert_eq!(
+            thinned(&cloud[..MAX_DRAWN_POINTS], MAX_DRAWN_POINTS).count(),
+            MAX_DRAWN_POINTS
+        );
+        assert_eq!(thinned(&[], MAX_DRAWN_POINTS).count(), 0);
+    }
+
+    /// Pixel bounds (x0, y0, x1, y1, canvas coordinates) of world points in a view.
+    fn bounds(points: &[[f32; 3]], view: View, margin: f32) -> [f32; 4] {
+        let mut b = [f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY];
+        for p in points {
+            let [x, y] = pixel(&Vector3::from(*p), view);
+            b = [
+                b[0].min(x - margin),
+                b[1].min(y - margin),
+                b[2].max(x + margin),
+                b[3].max(y + margin),
+            ];
+        }
+        b
+    }
+
+    #[test]
+    fn clouds_and_meshes_are_drawn_where_they_are_in_every_view_and_nowhere_else() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/surfaces.json");
+        let dir = std::path::Path::new(path).parent().unwrap();
+        let problem = parse_problem_in(&std::fs::read_to_string(path).unwrap(), dir).unwrap();
+        let mut bare = problem.clone();
+        bare.surfaces.obstacles.clear();
+        let (with, without) = (
+            picture(&problem, None, false).unwrap(),
+            picture(&bare, None, false).unwrap(),
+        );
+        let changed = |x: usize, y: usize| {
+            let k = y * with.width + x;
+            (0..3).any(|c| (with.pixels[k][c] - without.pixels[k][c]).abs() > 1e-4)
+        };
+        // Each obstacle's pixel bounds: within them (less a pixel) mostly drawn (a cloud's
+        // dots leave its corners), nothing drawn beyond them (plus a pixel and a half).
+        let [cloud, mesh] = [0, 1].map(|k| match &problem.surfaces.obstacles[k].kind {
+            SurfaceKind::Points { points, radius, .. } => (points.clone(), radius * SCALE),
+            SurfaceKind::Mesh { vertices, triangles } => {
+                assert_eq!(triangles.len(), 12);
+                (vertices.clone(), 0.0)
+            }
+        });
+        assert_eq!(cloud.0.len(), 400);
+        let mut inside = vec![false; with.pixels.len()];
+        let range = |lo: f32, hi: f32, end: usize| (lo.ceil().max(0.0) as usize)..=(hi.floor() as usize).min(end - 1);
+        for view in VIEWS {
+            for (points, margin) in [&cloud, &mesh] {
+                let b = bounds(points, view, margin + 1.5);
+                for y in range(b[1], b[3], PANEL) {
+                    for x in range(b[0], b[2], with.width) {
+                        inside[y * with.width + x] = true;
+                    }
+                }
+                let b = bounds(points, view, margin - 1.0);
+                let (mut n, mut hit) = (0, 0);
+                for y in range(b[1], b[3], PANEL) {
+                    for x in range(b[0], b[2], with.width) {
+                        n += 1;
+                        hit += usize::from(changed(x, y));
+                    }
+                }
+                assert!(
+                    n > 20 && hit as f32 >= 0.9 * n as f32,
+                    "panel {}: {hit} of {n} pixels drawn",
+                    view.panel()
+                );
+            }
+        }
+        let stray = (0..PANEL)
+            .flat_map(|y| (0..with.width).map(move |x| (x, y)))
+            .filter(|&(x, y)| changed(x, y) && !inside[y * with.width + x])
+            .count();
+        assert_eq!(stray, 0, "pixels drawn outside the cloud and the mesh");
+        // The mesh's centre, in the side view: grey, as translucent as a primitive.
+        let [x, y] = pixel(&Vector3::new(0.3, 0.65, 0.9), View::Side);
+        let p = with.pixels[y as usize * with.width + x as usize];
+        assert!(
+            p.iter().all(|&c| (0.6..0.9).contains(&c)) && (p[0] - p[1]).abs() < 1e-3,
+            "{p:?}"
+        );
+    }
 }

@@ -2,7 +2,9 @@
 //! viewer that opens offline in a browser (docs/viewer.md).
 //!
 //! Everything the page draws is computed here and embedded as JSON: the arm's visual meshes
-//! (the URDF's `<visual>` meshes with their origins), the obstacles, and for every sample of
+//! (the URDF's `<visual>` meshes with their origins), the obstacles (clouds and meshes as
+//! base64 little-endian `f32`/`u32` arrays, a cloud thinned to [`MAX_VIEW_POINTS`] points in
+//! all), and for every sample of
 //! the animation the world pose of each link frame from the core's forward kinematics. The
 //! page's JavaScript (`page.js`, on the vendored three.js in `vendor/three`) only places meshes
 //! at those poses and interpolates between samples; it computes no kinematics.
@@ -10,6 +12,7 @@
 use crate::Failure;
 use crate::formats::json::{Goal, Problem, parse_problem_in};
 use crate::formats::plan::{PlanDocument, parse_plan};
+use crate::formats::surface::{SurfaceKind, SurfaceObstacle};
 use edmp_core::robot::kinematics::{Joints, Pose, forward_with};
 use edmp_core::robot::{FRAME_NAMES, FRAMES, HAND_FRAME, TCP_FRAME};
 use edmp_core::scene::{Obstacle, Shape};
@@ -103,6 +106,9 @@ pub const EVEN_STEP_S: f32 = 0.1;
 /// Most animation samples per second taken from a timed trajectory (the page interpolates
 /// between them); a denser trajectory is thinned, its last point always kept.
 pub const MAX_SAMPLE_RATE: f32 = 50.0;
+/// Most cloud points the page holds, all clouds together: beyond it every k-th point of the
+/// clouds (taken in the scene's order) is kept, k the smallest that fits.
+pub const MAX_VIEW_POINTS: usize = 100_000;
 
 /// Reads the scene (and plan), writes the page. Bad input: exit 2 naming the file and JSON path,
 /// nothing written.
@@ -253,6 +259,63 @@ fn primitive(o: &Obstacle) -> Value {
     out
 }
 
+/// The kept points of each cloud: every `stride`-th of the clouds taken in order, `stride`
+/// the smallest that keeps at most `max` in all.
+fn thin_clouds<'a>(clouds: &[&'a [[f32; 3]]], max: usize) -> Vec<Vec<&'a [f32; 3]>> {
+    let total: usize = clouds.iter().map(|c| c.len()).sum();
+    let stride = total.div_ceil(max.max(1)).max(1);
+    let mut at = 0;
+    clouds
+        .iter()
+        .map(|c| {
+            // The first point of this cloud that is a multiple of `stride` in the whole list.
+            let first = (stride - at % stride) % stride;
+            at += c.len();
+            c.iter().skip(first).step_by(stride).collect()
+        })
+        .collect()
+}
+
+/// The clouds and meshes as the page draws them: `points` (a cloud's kept points, `x y z`
+/// little-endian `f32`, base64) with the ball `radius` and the cloud's full `count`; a mesh's
+/// `vertices` (`f32`) and triangle `indices` (`u32`), base64. `index` is the obstacle's index
+/// in the scene file.
+fn surfaces(obstacles: &[SurfaceObstacle]) -> Vec<Value> {
+    let clouds: Vec<&[[f32; 3]]> = obstacles
+        .iter()
+        .filter_map(|o| match &o.kind {
+            SurfaceKind::Points { points, .. } => Some(points.as_slice()),
+            SurfaceKind::Mesh { .. } => None,
+        })
+        .collect();
+    let mut kept = thin_clouds(&clouds, MAX_VIEW_POINTS).into_iter();
+    let floats =
+        |v: &mut dyn Iterator<Item = &[f32; 3]>| base64(&v.flatten().flat_map(|x| x.to_le_bytes()).collect::<Vec<_>>());
+    obstacles
+        .iter()
+        .map(|o| match &o.kind {
+            SurfaceKind::Points { points, radius, .. } => {
+                let drawn = kept.next().unwrap_or_default();
+                json!({
+                    "type": "points",
+                    "index": o.index,
+                    "radius": radius,
+                    "count": points.len(),
+                    "drawn": drawn.len(),
+                    "points": floats(&mut drawn.into_iter()),
+                })
+            }
+            SurfaceKind::Mesh { vertices, triangles } => json!({
+                "type": "mesh",
+                "index": o.index,
+                "triangles": triangles.len(),
+                "vertices": floats(&mut vertices.iter()),
+                "indices": base64(&triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect::<Vec<_>>()),
+            }),
+        })
+        .collect()
+}
+
 fn tcp_path(path: &[Joints<f32>], finger: f32, at: &str) -> Result<Vec<[f64; 3]>, String> {
     path.iter()
         .enumerate()
@@ -312,6 +375,7 @@ fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Res
         "hand_frame": HAND_FRAME,
         "meshes": robot_meshes()?,
         "obstacles": problem.scene().obstacles().iter().map(primitive).collect::<Vec<_>>(),
+        "surfaces": surfaces(&problem.surfaces.obstacles),
         "held": problem.scene().held().map(primitive),
         "samples": {"times": times, "poses": poses, "tcp": tcp},
         "start_tcp": start_tcp,
@@ -576,5 +640,85 @@ mod tests {
             assert!((tcp[c] - f64::from(k.tcp().translation[c])).abs() < 1e-6);
             assert_eq!(poses[7 * TCP_FRAME + c], tcp[c]);
         }
+    }
+
+    fn unbase64(text: &str) -> Vec<u8> {
+        const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let sextets: Vec<u32> = text
+            .bytes()
+            .filter(|&b| b != b'=')
+            .map(|b| ALPHABET.iter().position(|&a| a == b).unwrap() as u32)
+            .collect();
+        let mut out = Vec::new();
+        for chunk in sextets.chunks(4) {
+            let n = chunk.iter().enumerate().fold(0, |n, (k, s)| n | (s << (18 - 6 * k)));
+            out.extend(&n.to_be_bytes()[1..chunk.len()]);
+        }
+        out
+    }
+
+    #[test]
+    fn clouds_are_thinned_to_every_kth_point_of_all_together() {
+        let (a, b): (Vec<[f32; 3]>, Vec<[f32; 3]>) = (
+            (0..70_000).map(|i| [i as f32, 0.0, 0.0]).collect(),
+            (70_000..150_001).map(|i| [i as f32, 0.0, 0.0]).collect(),
+        );
+        let kept = thin_clouds(&[&a, &[], &b], MAX_VIEW_POINTS);
+        // 150,001 points: every 2nd, 75,001 in all, by their index in the whole list.
+        assert_eq!(kept.iter().map(Vec::len).sum::<usize>(), 75_001);
+        assert!(kept.iter().flatten().all(|p| (p[0] as usize).is_multiple_of(2)));
+        assert_eq!(kept[1].len(), 0);
+        let small = thin_clouds(&[&a[..10]], MAX_VIEW_POINTS);
+        assert_eq!(small[0].len(), 10);
+    }
+
+    #[test]
+    fn the_page_holds_the_clouds_points_and_the_meshes_triangles() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/surfaces.json");
+        let dir = Path::new(path).parent().unwrap();
+        let problem = parse_problem_in(&std::fs::read_to_string(path).unwrap(), dir).unwrap();
+        let data = embedded_data(&page(&problem, None, "surfaces").unwrap());
+        assert_eq!(data["obstacles"].as_array().unwrap().len(), 1, "the sphere");
+        let floats = |v: &Value| -> Vec<f32> {
+            unbase64(v.as_str().unwrap())
+                .chunks(4)
+                .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+                .collect()
+        };
+        let list = data["surfaces"].as_array().unwrap();
+        assert_eq!(list.len(), 2);
+        let (cloud, mesh) = (&list[0], &list[1]);
+        assert_eq!(
+            (cloud["type"].as_str(), cloud["index"].as_u64()),
+            (Some("points"), Some(0))
+        );
+        assert_eq!(
+            (cloud["count"].as_u64(), cloud["drawn"].as_u64()),
+            (Some(400), Some(400))
+        );
+        assert_eq!(cloud["radius"].as_f64(), Some(0.01f32 as f64));
+        let SurfaceKind::Points { points, .. } = &problem.surfaces.obstacles[0].kind else {
+            panic!("a cloud first")
+        };
+        assert_eq!(
+            floats(&cloud["points"]),
+            points.iter().flatten().copied().collect::<Vec<_>>()
+        );
+        // Placed in the world: the grid's corner is at the centre plus (0, -0.15, -0.15).
+        assert!((points[0][1] - -0.75).abs() < 1e-6 && (points[0][2] - 0.9).abs() < 1e-6);
+        assert_eq!((mesh["type"].as_str(), mesh["index"].as_u64()), (Some("mesh"), Some(2)));
+        let SurfaceKind::Mesh { vertices, triangles } = &problem.surfaces.obstacles[1].kind else {
+            panic!("a mesh second")
+        };
+        assert_eq!(mesh["triangles"].as_u64(), Some(12));
+        assert_eq!(
+            floats(&mesh["vertices"]),
+            vertices.iter().flatten().copied().collect::<Vec<_>>()
+        );
+        let indices: Vec<u32> = unbase64(mesh["indices"].as_str().unwrap())
+            .chunks(4)
+            .map(|b| u32::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        assert_eq!(indices, triangles.iter().flatten().copied().collect::<Vec<_>>());
     }
 }

@@ -72,17 +72,60 @@ function primitive(o, material) {
   return mesh;
 }
 
-const obstacleMaterial = new THREE.MeshLambertMaterial({ color: 0xd9822b, transparent: true, opacity: 0.8 });
+const OBSTACLE_COLOUR = 0xd9822b;
+const obstacleMaterial = new THREE.MeshLambertMaterial({ color: OBSTACLE_COLOUR, transparent: true, opacity: 0.8 });
 for (const o of data.obstacles) {
   scene.add(primitive(o, obstacleMaterial));
 }
 
-// ---- the arm: one group per link frame, posed from the samples; the URDF's visual meshes are
-// its children at their visual origins.
+/** A little-endian typed array from base64 (how the page holds every binary array). */
 function decode(base64, Type) {
   const bytes = Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
   return new Type(bytes.buffer);
 }
+
+// ---- clouds (one dot per kept point, the size of its ball) and meshes (their triangles in
+// the obstacles' material, both sides, flat shaded).
+const meshMaterial = obstacleMaterial.clone();
+meshMaterial.side = THREE.DoubleSide;
+meshMaterial.flatShading = true;
+// A round dot: a disc in a small texture, the corners cut by the alpha test.
+const DISC = 32;
+const discPixels = new Uint8Array(4 * DISC * DISC);
+for (let k = 0; k < DISC * DISC; k++) {
+  const x = (k % DISC) + 0.5 - DISC / 2;
+  const y = Math.floor(k / DISC) + 0.5 - DISC / 2;
+  discPixels.set([255, 255, 255, x * x + y * y <= (DISC * DISC) / 4 ? 255 : 0], 4 * k);
+}
+const disc = new THREE.DataTexture(discPixels, DISC, DISC);
+disc.needsUpdate = true;
+let cloudPoints = 0;
+let meshTriangles = 0;
+for (const s of data.surfaces) {
+  const geometry = new THREE.BufferGeometry();
+  if (s.type === "points") {
+    geometry.setAttribute("position", new THREE.BufferAttribute(decode(s.points, Float32Array), 3));
+    // With size attenuation a point of size S is S * (canvas height / 2) / depth pixels wide;
+    // a ball of diameter 2r is 2r / tan(fov / 2) times that.
+    const size = (2 * s.radius) / Math.tan(THREE.MathUtils.degToRad(camera.fov / 2));
+    const material = new THREE.PointsMaterial({ color: OBSTACLE_COLOUR, size, map: disc, alphaTest: 0.5 });
+    scene.add(new THREE.Points(geometry, material));
+    cloudPoints += s.drawn;
+  } else if (s.type === "mesh") {
+    geometry.setAttribute("position", new THREE.BufferAttribute(decode(s.vertices, Float32Array), 3));
+    geometry.setIndex(new THREE.BufferAttribute(decode(s.indices, Uint32Array), 1));
+    geometry.computeVertexNormals();
+    scene.add(new THREE.Mesh(geometry, meshMaterial));
+    meshTriangles += s.triangles;
+  } else {
+    throw new Error(`obstacles of type ${s.type} cannot be drawn`);
+  }
+}
+body.dataset.cloudPoints = String(cloudPoints);
+body.dataset.meshTriangles = String(meshTriangles);
+
+// ---- the arm: one group per link frame, posed from the samples; the URDF's visual meshes are
+// its children at their visual origins.
 
 const frames = data.frames.map(() => new THREE.Group());
 frames.forEach((g) => scene.add(g));
@@ -162,7 +205,21 @@ for (const name of order) {
   cell.className = "ms";
   cell.textContent = `${ms.toFixed(1)} ms`;
 }
-summary.append(` · ${data.obstacles.length} obstacles`);
+summary.append(` · ${data.obstacles.length} obstacle${data.obstacles.length === 1 ? "" : "s"}`);
+for (const kind of ["points", "mesh"]) {
+  const list = data.surfaces.filter((s) => s.type === kind);
+  if (list.length === 0) continue;
+  const many = list.length > 1;
+  if (kind === "mesh") {
+    const triangles = list.reduce((n, s) => n + s.triangles, 0);
+    summary.append(` · ${list.length} mesh${many ? "es" : ""} (${triangles} triangles)`);
+  } else {
+    const count = list.reduce((n, s) => n + s.count, 0);
+    const drawn = list.reduce((n, s) => n + s.drawn, 0);
+    const points = drawn < count ? `${drawn} of ${count} points drawn` : `${count} points`;
+    summary.append(` · ${list.length} cloud${many ? "s" : ""} (${points})`);
+  }
+}
 
 // ---- time: pose every frame at time t (seconds), interpolating between samples.
 const times = data.samples.times;
