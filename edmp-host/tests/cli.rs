@@ -247,7 +247,26 @@ fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
         .iter()
         .map(|(n, t, m)| (*n, t.to_string(), *m))
         .collect();
-    cases.push(("too many obstacles", too_many, "obstacles: 65 obstacles, at most 64"));
+    cases.push(("too many obstacles", too_many, "obstacles: 65 primitive obstacles, at most 64"));
+    // Clouds and meshes by file, beside the scene: the error names the obstacle and the file.
+    std::fs::write(dir.join("short.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 1 1\n").unwrap();
+    std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
+    let with = |obstacle: &str| {
+        format!(r#"{{"format": "edmp-scene/1", "obstacles": [{obstacle}], "start": [0,0,0,-2,0,2,0], "goal": {{"joints": [0,0,0,-2,0,2,0]}}}}"#)
+    };
+    let surface_cases = [
+        ("missing cloud file", with(r#"{"type": "points", "file": "absent.ply", "radius": 0.01}"#), "absent.ply: cannot read"),
+        ("truncated PLY", with(r#"{"type": "points", "file": "short.ply", "radius": 0.01}"#), "short.ply: line 9: element \"vertex\" row 2"),
+        ("OBJ index out of range", with(r#"{"type": "mesh", "file": "bad.obj"}"#), "obstacles[0].file: "),
+        ("cloud radius", with(r#"{"type": "points", "points": [[3, 0, 0]], "radius": 0}"#), "obstacles[0].radius: must be positive"),
+        ("cloud point", with(r#"{"type": "points", "points": [[3, 0]], "radius": 0.01}"#), "obstacles[0].points[0]: expected 3 numbers"),
+        ("mesh index", with(r#"{"type": "mesh", "vertices": [[3, 0, 0], [3, 1, 0], [3, 0, 1]], "triangles": [[0, 1, 3]]}"#), "obstacles[0].triangles[0][2]: expected a vertex index below 3"),
+        ("mesh scale", with(r#"{"type": "mesh", "vertices": [[3, 0, 0], [3, 1, 0], [3, 0, 1]], "triangles": [[0, 1, 2]], "scale": -1}"#), "obstacles[0].scale: must be positive"),
+        ("cloud on the start", with(r#"{"type": "points", "points": [[0, 0, 0.5]], "radius": 0.05}"#), "start: in collision: "),
+    ];
+    for (name, text, message) in surface_cases {
+        cases.push((name, text, message));
+    }
     for (name, text, message) in cases {
         let scene = dir.join("scene.json");
         std::fs::write(&scene, text).unwrap();
