@@ -4,6 +4,7 @@
 //! benchmark's scenes and `rrt` is the classical baseline. Planning math lives in `edmp-core`.
 
 pub mod commands;
+pub mod depth;
 pub mod formats;
 mod metrics;
 pub mod planning;

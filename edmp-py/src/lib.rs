@@ -18,6 +18,7 @@ use edmp_host::planning::{chosen_guides, plan_problem};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 use serde_json::{Value, json};
 use std::time::Instant;
 
@@ -233,9 +234,32 @@ fn view_page(scene: &str, plan: Option<&str>, title: &str) -> PyResult<String> {
     edmp_host::commands::view::page(&problem, plan.as_ref(), title).map_err(PlanError::new_err)
 }
 
+/// `edmp_host::depth::points_from_depth_le_bytes` (conventions in `edmp_host::depth`): `depth`
+/// is the `height × width` image, row-major, as little-endian `f32` bytes (numpy's
+/// `astype('<f4').tobytes()`); the world points come back as little-endian `f32` bytes, `x, y,
+/// z` per point. Raises `ValueError` naming the argument. The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (depth, width, height, k, pose, max_depth = None))]
+fn points_from_depth<'py>(
+    py: Python<'py>,
+    depth: &[u8],
+    width: usize,
+    height: usize,
+    k: [[f64; 3]; 3],
+    pose: [[f64; 4]; 4],
+    max_depth: Option<f32>,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let bytes =
+        py.detach(move || edmp_host::depth::points_from_depth_le_bytes(depth, width, height, k, pose, max_depth));
+    Ok(PyBytes::new(py, &bytes.map_err(PyValueError::new_err)?))
+}
+
 /// The native half of `edmp` (use the `edmp` package).
 #[pymodule]
 mod _edmp {
     #[pymodule_export]
-    use super::{PlanError, SceneError, check, fk, ik, import_moveit, plan, plan_problem_ms, validate, view_page};
+    use super::{
+        PlanError, SceneError, check, fk, ik, import_moveit, plan, plan_problem_ms, points_from_depth, validate,
+        view_page,
+    };
 }

@@ -297,3 +297,197 @@ def test_show_draws_what_the_cli_view_draws(
     theirs = _page_data(cli.read_text())
     assert ours.pop("title") == "edmp plan" and theirs.pop("title") == "wall.json — plan.json"
     assert ours == theirs
+
+
+# Point clouds, meshes and depth images: the wall of examples/wall.json (obstacles[1], a
+# 0.3 × 0.02 × 0.5 m box at (0.55, 0, 0.45)) given as a cloud or a mesh instead.
+
+
+def _without_the_wall(wall: edmp.Scene) -> edmp.Scene:
+    doc = wall.to_dict()
+    del doc["obstacles"][1]
+    return edmp.Scene.from_dict(doc)
+
+
+def _wall_points(spacing: float = 0.01) -> np.ndarray:
+    """The wall's mid-plane y = 0 as a grid of points (x in [0.4, 0.7], z in [0.2, 0.7])."""
+    x, z = np.meshgrid(np.arange(0.4, 0.7 + 1e-9, spacing), np.arange(0.2, 0.7 + 1e-9, spacing))
+    return np.stack([x.ravel(), np.zeros(x.size), z.ravel()], axis=1)
+
+
+def _straight(scene: edmp.Scene) -> np.ndarray:
+    """The straight joint-space motion from start to goal, as 50 waypoints."""
+    return np.linspace(scene.start, scene.goal, 50)
+
+
+def _blocks_the_straight_motion_and_plans_around(scene: edmp.Scene, index: int) -> None:
+    report = edmp.check(scene, _straight(scene))
+    assert not report and report.first_contact is not None
+    assert f"obstacles[{index}]" in report.first_contact["contact"]
+    p = edmp.plan(scene, seed=0)
+    assert p.status == "success"
+    assert edmp.check(scene, p.waypoints)
+
+
+def test_a_wall_of_points_blocks_the_straight_motion_and_is_planned_around(wall: edmp.Scene) -> None:
+    open_scene = _without_the_wall(wall)
+    assert edmp.check(open_scene, _straight(open_scene))  # the wall's box was the obstacle
+    points = _wall_points()
+    scene = open_scene.add_points(points, radius=0.0075)
+    assert isinstance(scene, edmp.Scene) and len(open_scene.obstacles) == 3  # a new scene
+    added = scene.obstacles[-1]
+    assert added["type"] == "points" and added["radius"] == 0.0075 and "filter_robot" not in added
+    np.testing.assert_array_equal(added["points"], points)
+    assert edmp.Scene.from_json(scene.to_json()).to_dict() == scene.to_dict()
+    _blocks_the_straight_motion_and_plans_around(scene, 3)
+
+
+def test_filter_robot_drops_the_points_on_the_arm(wall: edmp.Scene) -> None:
+    # The wall and, as a camera that sees the arm would have it, points on the arm at the start.
+    on_arm = [f["position"] for f in edmp.fk(wall.start)["frames"][3:10]]  # panda_link3 .. panda_hand
+    cloud = np.vstack([_wall_points(0.02), on_arm])
+    with pytest.raises(edmp.SceneError, match=r"start: in collision: .*obstacles\[3\]"):
+        _without_the_wall(wall).add_points(cloud, radius=0.0075)
+    scene = _without_the_wall(wall).add_points(cloud, radius=0.0075, filter_robot=0.01)
+    assert scene.obstacles[-1]["filter_robot"] == 0.01
+    assert not edmp.check(scene, _straight(scene))
+
+
+def test_a_box_mesh_blocks_the_straight_motion_and_is_planned_around(wall: edmp.Scene) -> None:
+    corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+    # Two triangles per face of the unit cube (vertex index = 4x + 2y + z, each 0 or 1).
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    triangles = np.array([t for a, b, c, d in faces for t in ((a, b, c), (a, c, d))], dtype=np.int32)
+    scene = _without_the_wall(wall).add_mesh(
+        corners, triangles, center=[0.55, 0.0, 0.45], quaternion=[1, 0, 0, 0], scale=[0.3, 0.02, 0.5]
+    )
+    added = scene.obstacles[-1]
+    assert added["type"] == "mesh" and added["scale"] == [0.3, 0.02, 0.5] and len(added["triangles"]) == 12
+    _blocks_the_straight_motion_and_plans_around(scene, 3)
+    # Placed by hand instead: the same obstacle.
+    placed = _without_the_wall(wall).add_mesh(corners * [0.3, 0.02, 0.5] + [0.55, 0.0, 0.45], triangles)
+    assert not edmp.check(placed, _straight(placed))
+    assert _without_the_wall(wall).add_mesh(corners, triangles, scale=0.01).obstacles[-1]["scale"] == 0.01
+
+
+def test_bad_clouds_and_meshes_are_value_errors_naming_the_argument(wall: edmp.Scene) -> None:
+    ok = _wall_points(0.05)
+    cube = np.eye(3)
+    tri = np.array([[0, 1, 2]])
+    infinite = cube.copy()
+    infinite[1, 2] = np.inf
+    bad = ok.copy()
+    bad[3, 1] = np.nan
+    cases = [
+        (lambda: wall.add_points(ok[:, :2], 0.01), r"points: expected shape \(N, 3\), found \(77, 2\)"),
+        (lambda: wall.add_points(ok.ravel(), 0.01), r"points: expected shape \(N, 3\)"),
+        (lambda: wall.add_points(bad, 0.01), r"points\[3\]: \[.*nan.*\] is not finite"),
+        (lambda: wall.add_points([["a", "b", "c"]], 0.01), "points: not an array of numbers"),
+        (lambda: wall.add_points(ok, 0.0), "radius: 0.0 is not positive"),
+        (lambda: wall.add_points(ok, float("inf")), "radius"),
+        (lambda: wall.add_points(ok, 0.01, filter_robot=-1), "filter_robot: -1.0 is not non-negative"),
+        (lambda: wall.add_mesh(cube[:, :2], tri), r"vertices: expected shape \(N, 3\)"),
+        (lambda: wall.add_mesh(infinite, tri), r"vertices\[1\]: \[0.0, 1.0, inf\] is not finite"),
+        (lambda: wall.add_mesh(cube, tri.astype(float)), "triangles: expected integer vertex indices"),
+        (lambda: wall.add_mesh(cube, [[0, 1, 2], [1, 2, 3]]), r"triangles\[1\]: \[1, 2, 3\]: a vertex index outside"),
+        (lambda: wall.add_mesh(cube, [[0, -1, 2]]), r"triangles\[0\]"),
+        (lambda: wall.add_mesh(cube, [0, 1, 2]), r"triangles: expected shape \(T, 3\)"),
+        (lambda: wall.add_mesh(cube, tri, center=[0, 0]), r"center: expected shape \(3,\)"),
+        (lambda: wall.add_mesh(cube, tri, center=[0, np.nan, 0]), "center: .* is not finite"),
+        (lambda: wall.add_mesh(cube, tri, quaternion=[1, 0, 0]), "quaternion"),
+        (lambda: wall.add_mesh(cube, tri, scale=[1, 0, 1]), "scale: 0.0 is not positive"),
+        (lambda: wall.add_mesh(cube, tri, scale=[1, 1]), r"scale: expected a number or shape \(3,\)"),
+    ]
+    for call, message in cases:
+        with pytest.raises(ValueError, match=message):
+            call()
+    # What only the scene reader knows is a SceneError naming the JSON path.
+    with pytest.raises(edmp.SceneError, match=r"obstacles\[4\]\.quaternion: norm"):
+        wall.add_mesh(cube, tri, quaternion=[1, 1, 0, 0])
+    assert len(wall.obstacles) == 4  # nothing was added
+
+
+# A pinhole camera: 100 px per metre at 1 m, principal point at the centre of a 64 × 48 image.
+K = np.array([[100.0, 0.0, 31.5], [0.0, 100.0, 23.5], [0.0, 0.0, 1.0]])
+
+
+def test_points_from_depth_of_a_plane_in_the_camera_frame() -> None:
+    depth = np.ones((48, 64), dtype=np.float32)
+    pts = edmp.points_from_depth(depth, K, np.eye(4))
+    assert pts.shape == (64 * 48, 3) and pts.dtype == np.float64
+    np.testing.assert_array_equal(pts[:, 2], 1.0)
+    u, v = np.meshgrid(np.arange(64), np.arange(48))  # row-major: v is the row
+    np.testing.assert_allclose(pts[:, 0], (u.ravel() - 31.5) / 100.0, atol=1e-7)
+    np.testing.assert_allclose(pts[:, 1], (v.ravel() - 23.5) / 100.0, atol=1e-7)
+    # No return (0, NaN, inf) and beyond max_depth: dropped. Depth scales the ray.
+    depth[0, 0], depth[0, 1], depth[0, 2], depth[1, 0] = 0.0, np.nan, np.inf, 2.0
+    assert len(edmp.points_from_depth(depth, K, np.eye(4))) == 64 * 48 - 3
+    near = edmp.points_from_depth(depth, K, np.eye(4), max_depth=1.5)
+    assert len(near) == 64 * 48 - 4 and near[:, 2].max() == 1.0
+    far = edmp.points_from_depth(depth.astype(np.float64), K, np.eye(4))[61]  # pixel (0, 1)
+    np.testing.assert_allclose(far, [2.0 * -31.5 / 100, 2.0 * -22.5 / 100, 2.0], atol=1e-6)
+
+
+def _rotation(w: float, x: float, y: float, z: float) -> np.ndarray:
+    q = np.array([w, x, y, z]) / np.linalg.norm([w, x, y, z])
+    w, x, y, z = q
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def test_points_from_depth_with_a_rotated_translated_camera() -> None:
+    # Looking down from 1.5 m (camera z = world −z, camera x = world x, so image down = world −y).
+    down = np.array([[1.0, 0, 0, 0.5], [0, -1.0, 0, 0.0], [0, 0, -1.0, 1.5], [0, 0, 0, 1]])
+    pts = edmp.points_from_depth(np.full((48, 64), 1.5), K, down)
+    np.testing.assert_allclose(pts[:, 2], 0.0, atol=1e-6)  # the table at z = 0
+    np.testing.assert_allclose(pts[0], [0.5 - 1.5 * 0.315, 1.5 * 0.235, 0.0], atol=1e-6)
+    # Any pose: R · d · K⁻¹ · [u, v, 1] + t.
+    rng = np.random.default_rng(0)
+    pose = np.eye(4)
+    pose[:3, :3], pose[:3, 3] = _rotation(0.3, -0.5, 0.7, 0.2), [0.1, -0.4, 0.9]
+    depth = rng.uniform(0.3, 2.0, (48, 64))
+    u, v = np.meshgrid(np.arange(64), np.arange(48))
+    rays = np.linalg.inv(K) @ np.stack([u.ravel(), v.ravel(), np.ones(u.size)])
+    expected = (pose[:3, :3] @ (rays * depth.ravel()) + pose[:3, 3:]).T
+    np.testing.assert_allclose(edmp.points_from_depth(depth, K, pose), expected, atol=1e-5)
+
+
+def test_points_from_depth_names_the_bad_argument() -> None:
+    ok = np.ones((4, 5))
+    skewed = np.eye(4)
+    skewed[0, 1] = 0.01
+    cases = [
+        (lambda: edmp.points_from_depth(np.ones(20), K, np.eye(4)), r"depth: expected an \(H, W\) image"),
+        (lambda: edmp.points_from_depth(ok.astype(np.uint16), K, np.eye(4)), "depth: expected float metres"),
+        (lambda: edmp.points_from_depth(ok, K[:2], np.eye(4)), r"K: expected shape \(3, 3\)"),
+        (lambda: edmp.points_from_depth(ok, np.diag([0.0, 100.0, 1.0]), np.eye(4)), "K: focal lengths"),
+        (lambda: edmp.points_from_depth(ok, K * np.nan, np.eye(4)), "K: not finite"),
+        (lambda: edmp.points_from_depth(ok, K, np.eye(3)), r"pose: expected shape \(4, 4\)"),
+        (lambda: edmp.points_from_depth(ok, K, skewed), "pose: the rotation .* is not orthonormal"),
+        (lambda: edmp.points_from_depth(ok, K, np.diag([1.0, 1.0, -1.0, 1.0])), "pose: .* reflection"),
+        (lambda: edmp.points_from_depth(ok, K, np.eye(4), max_depth=0.0), "max_depth"),
+    ]
+    for call, message in cases:
+        with pytest.raises(ValueError, match=message):
+            call()
+
+
+def test_a_depth_image_of_the_wall_plans_like_the_wall(wall: edmp.Scene) -> None:
+    # The docs/python.md example: a camera 1 m in front of the wall's plane, looking along +y
+    # (camera x = world x, y = world −z, z = world y); the wall at 1 m, the room behind at 3 m.
+    k = np.array([[100.0, 0.0, 32.0], [0.0, 100.0, 32.0], [0.0, 0.0, 1.0]])
+    pose = np.array([[1.0, 0, 0, 0.55], [0, 0, 1.0, -1.0], [0, -1.0, 0, 0.45], [0, 0, 0, 1]])
+    u, v = np.meshgrid(np.arange(64), np.arange(64))
+    on_wall = (np.abs(u - 32) <= 15) & (np.abs(v - 32) <= 25)
+    depth = np.where(on_wall, 1.0, 3.0).astype(np.float32)
+    points = edmp.points_from_depth(depth, k, pose, max_depth=2.0)
+    assert points.shape == (31 * 51, 3)
+    rows = [np.round(p, 6) for p in (points, _wall_points())]
+    np.testing.assert_allclose(*(r[np.lexsort(r.T)] for r in rows), atol=1e-6)
+    scene = _without_the_wall(wall).add_points(points, radius=0.0075)
+    _blocks_the_straight_motion_and_plans_around(scene, 3)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import html
 import json
+import math
 import os
 import tempfile
 import webbrowser
@@ -42,6 +43,7 @@ __all__ = [
     "ik",
     "import_moveit",
     "plan",
+    "points_from_depth",
     "show",
 ]
 
@@ -54,6 +56,42 @@ def _vector(x: ArrayLike, n: int, what: str) -> list[float]:
     if a.shape != (n,):
         raise ValueError(f"{what}: expected shape ({n},), found {a.shape}")
     return [float(v) for v in a]
+
+
+def _array(x: Any, what: str, dtype: Any = np.float64) -> np.ndarray:
+    try:
+        return np.asarray(x, dtype=dtype)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{what}: not an array of numbers ({e})") from None
+
+
+def _finite_vector(x: ArrayLike, n: int, what: str) -> list[float]:
+    v = _vector(_array(x, what), n, what)
+    if not all(math.isfinite(c) for c in v):
+        raise ValueError(f"{what}: {v} is not finite")
+    return v
+
+
+def _rows(x: ArrayLike, what: str) -> Array:
+    """``x`` as a finite ``(N, 3)`` float64 array, else a ``ValueError`` naming ``what``."""
+    a = _array(x, what)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{what}: expected shape (N, 3), found {a.shape}")
+    bad = ~np.isfinite(a).all(axis=1)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{what}[{i}]: {a[i].tolist()} is not finite")
+    return a
+
+
+def _positive(x: float, what: str, zero: bool = False) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: expected a number, found {x!r}") from None
+    if not math.isfinite(v) or v < 0 or (v == 0 and not zero):
+        raise ValueError(f"{what}: {v} is not {'non-negative' if zero else 'positive'} and finite")
+    return v
 
 
 @dataclass(frozen=True)
@@ -147,6 +185,78 @@ class Scene:
         doc = self.to_dict()
         doc["goal"] = {"joints": _vector(joints, 7, "joints")}
         return Scene(doc)
+
+    def add_points(self, points: ArrayLike, radius: float, filter_robot: Optional[float] = None) -> "Scene":
+        """The same scene plus a point-cloud obstacle: a ball of ``radius`` (m) around each
+        row of ``points``, an ``(N, 3)`` array in the world frame (for example from
+        :func:`points_from_depth`). With ``filter_robot`` the points within that distance (m)
+        of the robot at the start are dropped first (a camera that sees the arm).
+
+        Like :meth:`with_goal` it returns a new scene (scenes are values); it appends
+        ``{"type": "points", "points": [...], "radius": r}`` to ``obstacles``, read by the
+        same reader as a scene file. Clouds beyond the host's capacity (262,144 pieces, all
+        clouds and meshes together) are reduced to fit. Raises ``ValueError`` naming the
+        argument for a bad shape or a non-finite value, :class:`SceneError` for what the
+        reader refuses (the start or goal in collision with the cloud, say).
+        """
+        p = _rows(points, "points")
+        obstacle: dict[str, Any] = {"type": "points", "points": p.tolist(), "radius": _positive(radius, "radius")}
+        if filter_robot is not None:
+            obstacle["filter_robot"] = _positive(filter_robot, "filter_robot", zero=True)
+        return self._with_obstacle(obstacle)
+
+    def add_mesh(
+        self,
+        vertices: ArrayLike,
+        triangles: ArrayLike,
+        center: Optional[ArrayLike] = None,
+        quaternion: Optional[ArrayLike] = None,
+        scale: Union[float, ArrayLike, None] = None,
+    ) -> "Scene":
+        """The same scene plus a triangle-mesh obstacle: ``vertices`` an ``(V, 3)`` float
+        array, ``triangles`` a ``(T, 3)`` integer array of vertex indices. The mesh is placed
+        at world = ``center`` + rotation(``quaternion`` ``[w, x, y, z]``) · (``scale`` ⊙
+        vertex); ``scale`` is one number or three (default: the vertices are in the world).
+
+        Returns a new scene, as :meth:`add_points`, with ``{"type": "mesh", "vertices": [...],
+        "triangles": [...], ...}`` appended to ``obstacles``. Raises ``ValueError`` naming the
+        argument for a bad shape or dtype, a non-finite value or an index out of range, and
+        :class:`SceneError` for what the reader refuses (a quaternion of norm ≠ 1, say).
+        """
+        v = _rows(vertices, "vertices")
+        t = np.asarray(triangles)
+        if t.ndim != 2 or t.shape[1] != 3:
+            raise ValueError(f"triangles: expected shape (T, 3), found {t.shape}")
+        if t.size and not np.issubdtype(t.dtype, np.integer):
+            raise ValueError(f"triangles: expected integer vertex indices, found dtype {t.dtype}")
+        bad = ((t < 0) | (t >= len(v))).any(axis=1)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise ValueError(f"triangles[{i}]: {t[i].tolist()}: a vertex index outside [0, {len(v)})")
+        obstacle: dict[str, Any] = {"type": "mesh", "vertices": v.tolist(), "triangles": t.astype(np.int64).tolist()}
+        if center is not None:
+            obstacle["center"] = _finite_vector(center, 3, "center")
+        if quaternion is not None:
+            obstacle["quaternion"] = _finite_vector(quaternion, 4, "quaternion")
+        if scale is not None:
+            sa = _array(scale, "scale")
+            if sa.shape not in ((), (3,)):
+                raise ValueError(f"scale: expected a number or shape (3,), found {sa.shape}")
+            factors = [_positive(x, "scale") for x in sa.reshape(-1)]
+            obstacle["scale"] = factors[0] if sa.shape == () else factors
+        return self._with_obstacle(obstacle)
+
+    def _with_obstacle(self, obstacle: dict[str, Any]) -> "Scene":
+        # The document is never mutated in place, so the new one shares the old obstacles
+        # (no deep copy: a big cloud is serialised once, for the reader).
+        doc = dict(self._doc)
+        doc["obstacles"] = [*self._doc["obstacles"], obstacle]
+        text = json.dumps(doc)
+        _edmp.validate(text)
+        scene = Scene.__new__(Scene)
+        scene._doc = doc
+        scene._text = text
+        return scene
 
     def __repr__(self) -> str:
         kind = "joints" if "joints" in self._doc["goal"] else "pose"
@@ -267,6 +377,47 @@ def plan(
         _edmp.plan(_scene_text(scene), seed, candidates, timed, rate, velocity_scale, acceleration_scale)
     )
     return Plan.from_document(doc)
+
+
+def points_from_depth(
+    depth: ArrayLike,
+    K: ArrayLike,
+    pose: ArrayLike,
+    max_depth: Optional[float] = None,
+) -> Array:
+    """The world points of a depth image: an ``(N, 3)`` float64 array, for
+    :meth:`Scene.add_points`.
+
+    ``depth`` is an ``(H, W)`` float image in metres, each pixel the z of its point in the
+    camera frame (a z-buffer, as RGB-D drivers give it once scaled to metres; an integer
+    image, such as millimetres, is refused). ``K`` is the ``3 × 3`` pinhole intrinsics
+    ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]`` and ``pose`` the camera's ``4 × 4`` pose in the
+    world (camera → world), both in OpenCV's convention: camera x right, y down, z forward;
+    pixel ``(u, v)`` is column ``u``, row ``v``, with integer coordinates at pixel centres.
+    Pixels with no return (0, negative, NaN, inf) and beyond ``max_depth`` are dropped; the
+    rest come in row-major order. The back-projection is edmp-rs's
+    (``edmp_host::depth``; computed in f64, rounded to f32, the planner's precision).
+    Raises ``ValueError`` naming the argument: a bad shape, ``K`` not finite, not of that
+    form or with a focal length ≤ 0, ``pose`` not finite, not homogeneous, or its rotation
+    not orthonormal within 1e-4 or a reflection.
+    """
+    d = np.asarray(depth)
+    if d.ndim != 2:
+        raise ValueError(f"depth: expected an (H, W) image, found shape {d.shape}")
+    if not np.issubdtype(d.dtype, np.floating):
+        raise ValueError(
+            f"depth: expected float metres, found dtype {d.dtype} (convert integer depth, e.g. millimetres, to metres)"
+        )
+    k = _array(K, "K")
+    if k.shape != (3, 3):
+        raise ValueError(f"K: expected shape (3, 3), found {k.shape}")
+    p = _array(pose, "pose")
+    if p.shape != (4, 4):
+        raise ValueError(f"pose: expected shape (4, 4), found {p.shape}")
+    m = None if max_depth is None else float(max_depth)
+    h, w = d.shape
+    raw = _edmp.points_from_depth(np.ascontiguousarray(d, dtype="<f4").tobytes(), w, h, k.tolist(), p.tolist(), m)
+    return np.frombuffer(raw, dtype="<f4").reshape(-1, 3).astype(np.float64)
 
 
 def fk(q: ArrayLike) -> dict[str, Any]:
