@@ -247,22 +247,62 @@ fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
         .iter()
         .map(|(n, t, m)| (*n, t.to_string(), *m))
         .collect();
-    cases.push(("too many obstacles", too_many, "obstacles: 65 primitive obstacles, at most 64"));
+    cases.push((
+        "too many obstacles",
+        too_many,
+        "obstacles: 65 primitive obstacles, at most 64",
+    ));
     // Clouds and meshes by file, beside the scene: the error names the obstacle and the file.
     std::fs::write(dir.join("short.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 1 1\n").unwrap();
     std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
     let with = |obstacle: &str| {
-        format!(r#"{{"format": "edmp-scene/1", "obstacles": [{obstacle}], "start": [0,0,0,-2,0,2,0], "goal": {{"joints": [0,0,0,-2,0,2,0]}}}}"#)
+        format!(
+            r#"{{"format": "edmp-scene/1", "obstacles": [{obstacle}], "start": [0,0,0,-2,0,2,0], "goal": {{"joints": [0,0,0,-2,0,2,0]}}}}"#
+        )
     };
     let surface_cases = [
-        ("missing cloud file", with(r#"{"type": "points", "file": "absent.ply", "radius": 0.01}"#), "absent.ply: cannot read"),
-        ("truncated PLY", with(r#"{"type": "points", "file": "short.ply", "radius": 0.01}"#), "short.ply: line 9: element \"vertex\" row 2"),
-        ("OBJ index out of range", with(r#"{"type": "mesh", "file": "bad.obj"}"#), "obstacles[0].file: "),
-        ("cloud radius", with(r#"{"type": "points", "points": [[3, 0, 0]], "radius": 0}"#), "obstacles[0].radius: must be positive"),
-        ("cloud point", with(r#"{"type": "points", "points": [[3, 0]], "radius": 0.01}"#), "obstacles[0].points[0]: expected 3 numbers"),
-        ("mesh index", with(r#"{"type": "mesh", "vertices": [[3, 0, 0], [3, 1, 0], [3, 0, 1]], "triangles": [[0, 1, 3]]}"#), "obstacles[0].triangles[0][2]: expected a vertex index below 3"),
-        ("mesh scale", with(r#"{"type": "mesh", "vertices": [[3, 0, 0], [3, 1, 0], [3, 0, 1]], "triangles": [[0, 1, 2]], "scale": -1}"#), "obstacles[0].scale: must be positive"),
-        ("cloud on the start", with(r#"{"type": "points", "points": [[0, 0, 0.5]], "radius": 0.05}"#), "start: in collision: "),
+        (
+            "missing cloud file",
+            with(r#"{"type": "points", "file": "absent.ply", "radius": 0.01}"#),
+            "absent.ply: cannot read",
+        ),
+        (
+            "truncated PLY",
+            with(r#"{"type": "points", "file": "short.ply", "radius": 0.01}"#),
+            "short.ply: line 9: element \"vertex\" row 2",
+        ),
+        (
+            "OBJ index out of range",
+            with(r#"{"type": "mesh", "file": "bad.obj"}"#),
+            "obstacles[0].file: ",
+        ),
+        (
+            "cloud radius",
+            with(r#"{"type": "points", "points": [[3, 0, 0]], "radius": 0}"#),
+            "obstacles[0].radius: must be positive",
+        ),
+        (
+            "cloud point",
+            with(r#"{"type": "points", "points": [[3, 0]], "radius": 0.01}"#),
+            "obstacles[0].points[0]: expected 3 numbers",
+        ),
+        (
+            "mesh index",
+            with(r#"{"type": "mesh", "vertices": [[3, 0, 0], [3, 1, 0], [3, 0, 1]], "triangles": [[0, 1, 3]]}"#),
+            "obstacles[0].triangles[0][2]: expected a vertex index below 3",
+        ),
+        (
+            "mesh scale",
+            with(
+                r#"{"type": "mesh", "vertices": [[3, 0, 0], [3, 1, 0], [3, 0, 1]], "triangles": [[0, 1, 2]], "scale": -1}"#,
+            ),
+            "obstacles[0].scale: must be positive",
+        ),
+        (
+            "cloud on the start",
+            with(r#"{"type": "points", "points": [[0, 0, 0.5]], "radius": 0.05}"#),
+            "start: in collision: ",
+        ),
     ];
     for (name, text, message) in surface_cases {
         cases.push((name, text, message));
@@ -539,4 +579,41 @@ fn plans_are_the_same_on_any_number_of_threads() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--threads"));
     assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn filter_robot_drops_the_robots_own_points_and_the_plan_counts_them() {
+    use edmp_core::robot::HAND_FRAME;
+    use edmp_core::robot::kinematics::forward_with;
+    let wall: serde_json::Value = serde_json::from_str(include_str!("../../examples/wall.json")).unwrap();
+    let start: Vec<f32> = wall["start"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap() as f32)
+        .collect();
+    let k = forward_with(&<[f32; 7]>::try_from(start).unwrap(), 0.025).unwrap();
+    let hand = k.frames[HAND_FRAME].translation;
+    // Two points on the hand (a camera saw the robot) and one far away.
+    let cloud = serde_json::json!({"type": "points", "radius": 0.005,
+        "points": [[hand.x, hand.y, hand.z], [hand.x, hand.y, hand.z + 0.01], [1.5, 0.0, 0.0]]});
+    let dir = std::env::temp_dir().join(format!("edmp-filter-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("scene.json");
+    let mut doc = wall.clone();
+    doc["obstacles"].as_array_mut().unwrap().push(cloud.clone());
+    std::fs::write(&scene, doc.to_string()).unwrap();
+    let out = edmp_host(&["plan", scene.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("start: in collision: "));
+    let mut filtered = cloud;
+    filtered["filter_robot"] = serde_json::json!(0.02);
+    doc["obstacles"].as_array_mut().unwrap().pop();
+    doc["obstacles"].as_array_mut().unwrap().push(filtered);
+    std::fs::write(&scene, doc.to_string()).unwrap();
+    let out = edmp_host(&["plan", scene.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let plan: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(plan["points_filtered"], 2);
+    std::fs::remove_dir_all(&dir).ok();
 }

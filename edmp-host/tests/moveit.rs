@@ -7,7 +7,7 @@ use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::planner::PlanConfig;
 use edmp_core::robot::kinematics::forward;
 use edmp_host::formats::json::{Goal, joint_goal, parse_problem};
-use edmp_host::formats::moveit::{Source, import, import_validated};
+use edmp_host::formats::moveit::{import, import_validated};
 use edmp_host::planning::{chosen_guides, plan_problem};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use serde_json::{Value, json};
@@ -148,11 +148,17 @@ fn error(scene: &str, request: Option<&str>, want: &str) -> String {
 }
 
 #[test]
-fn a_mesh_is_an_error_that_names_it() {
-    let e = import(&file("mesh.scene.yaml"), None).unwrap_err();
-    assert_eq!(e.source, Source::Scene);
-    assert_eq!(e.path, "world.collision_objects[1].meshes");
-    assert!(e.message.starts_with("not supported: meshes"), "{e}");
+fn a_mesh_becomes_a_mesh_obstacle_placed_in_the_world() {
+    let doc = import(&file("mesh.scene.yaml"), Some(&file("joint_goal.request.yaml"))).unwrap();
+    let obstacles = doc["obstacles"].as_array().unwrap();
+    let meshes: Vec<&serde_json::Value> = obstacles.iter().filter(|o| o["type"] == "mesh").collect();
+    assert_eq!(meshes.len(), 1, "{obstacles:?}");
+    let m = meshes[0];
+    assert!(!m["vertices"].as_array().unwrap().is_empty() && !m["triangles"].as_array().unwrap().is_empty());
+    // The imported scene reads back as a problem whose surface holds the mesh's triangles.
+    let problem = parse_problem(&doc.to_string()).unwrap();
+    assert_eq!(problem.surfaces.obstacles.len(), 1);
+    assert!(problem.surfaces.pieces() > 0);
 }
 
 #[test]
@@ -473,15 +479,6 @@ fn exported_scenes_refuse_what_they_cannot_express_by_yaml_path() {
             "scene: point_cloud: unknown field",
         ),
         (
-            exported.replacen(
-                "    meshes: []\n    mesh_poses: []\n",
-                "    meshes:\n    - triangles:\n      - vertex_indices: [0, 1, 2]\n      vertices:\n      - {x: 0, y: 0, z: 0}\n      \
-                 - {x: 0.1, y: 0, z: 0}\n      - {x: 0, y: 0.1, z: 0}\n    mesh_poses:\n    - position: {x: 0.4, y: 0, z: 0.3}\n",
-                1,
-            ),
-            "scene: world.collision_objects[0].meshes: not supported: meshes (mesh obstacles are not yet supported",
-        ),
-        (
             exported.replacen("    meshes: []\n", "    meshes:\n    - {triangles: [[0, 1, 2]], vertices: [[0, 0, 0]]}\n", 1),
             "scene: world.collision_objects[0].mesh_poses: 0 poses for 1 meshes",
         ),
@@ -564,14 +561,15 @@ fn the_command_line_writes_a_scene_that_plans() {
     let text = std::fs::read_to_string(&out).unwrap();
     std::fs::remove_file(&out).ok();
     parse_problem(&text).unwrap();
-    let bad = Command::new(env!("CARGO_BIN_EXE_edmp-host"))
+    let meshed = Command::new(env!("CARGO_BIN_EXE_edmp-host"))
         .args(["import-moveit", "--scene", &format!("{DIR}/mesh.scene.yaml")])
         .output()
         .unwrap();
-    assert_eq!(bad.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&bad.stderr);
+    // No start in the scene and no request: refused by its YAML path.
+    assert_eq!(meshed.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&meshed.stderr);
     assert!(
-        stderr.contains("mesh.scene.yaml: world.collision_objects[1].meshes: not supported"),
+        stderr.contains("mesh.scene.yaml: robot_state.joint_state: no start"),
         "{stderr}"
     );
 }

@@ -54,7 +54,16 @@ fn nearest_other(q: &[f32; 7], b: usize, p: &Element) -> f32 {
 }
 
 fn checked(pieces: &mut [Element], q: &[f32; 7]) -> Option<Contact> {
-    let mut nodes = vec![Node { lo: [0.0; 3], hi: [0.0; 3], first: 0, count: 0, left: 0 }; nodes_for(pieces.len())];
+    let mut nodes = vec![
+        Node {
+            lo: [0.0; 3],
+            hi: [0.0; 3],
+            first: 0,
+            count: 0,
+            left: 0
+        };
+        nodes_for(pieces.len())
+    ];
     let used = build(pieces, &mut nodes).unwrap();
     let surface = Surface::new(pieces, &nodes[..used]).unwrap();
     let scene = Scene::<4>::new().with_surface(surface, &[]);
@@ -67,7 +76,9 @@ fn direction(theta: f32, phi: f32) -> Vector3<f32> {
 
 /// A few far-away balls, so the hierarchy has more than one leaf.
 fn far_balls() -> Vec<Element> {
-    (0..40).map(|i| Element::ball([3.0 + i as f32 * 0.1, 3.0, 0.0], RADIUS, 9).unwrap()).collect()
+    (0..40)
+        .map(|i| Element::ball([3.0 + i as f32 * 0.1, 3.0, 0.0], RADIUS, 9).unwrap())
+        .collect()
 }
 
 proptest! {

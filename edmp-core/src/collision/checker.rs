@@ -492,7 +492,11 @@ impl<'s, const N: usize> Prepared<'s, N> {
                     self.radius[b % SLOTS],
                     margin,
                     SURFACE_HORIZON,
-                    |e| placed.ball_clear_of_box(b, e, margin).or_else(|| placed.body_apart_from(b, e, hint)),
+                    |e| {
+                        placed
+                            .ball_clear_of_box(b, e, margin)
+                            .or_else(|| placed.body_apart_from(b, e, hint))
+                    },
                 );
                 match gap {
                     Ok(gap) => *slack = gap - carry,

@@ -343,30 +343,50 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     bar.set_style(
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {elapsed}").map_err(|e| input(e.to_string()))?,
     );
-    let one = |(family, path): &(String, PathBuf)| -> Result<Record, Failure> {
+    let one = |(family, path): &(String, PathBuf)| -> Result<Result<Record, String>, Failure> {
         let name = format!(
             "{family}/{}",
             path.file_name().map(|n| n.to_string_lossy()).unwrap_or_default()
         );
         let text = std::fs::read_to_string(path).map_err(|e| input(format!("{}: {e}", path.display())))?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        let mut record = match args.planner {
-            Planner::Edmp => run_edmp(args, &text, dir, &name)?,
-            Planner::RrtConnect => run_rrt(args, &text, dir, &name)?,
+        let planned = match args.planner {
+            Planner::Edmp => run_edmp(args, &text, dir, &name),
+            Planner::RrtConnect => run_rrt(args, &text, dir, &name),
         };
-        record.family = family.clone();
-        record.planner = label.clone();
         bar.inc(1);
-        Ok(record)
+        match planned {
+            Ok(mut record) => {
+                record.family = family.clone();
+                record.planner = label.clone();
+                Ok(Ok(record))
+            }
+            // A problem the scene reader refuses (e.g. an end inside a cloud's balls) is
+            // invalid input, not a planner failure: listed, not planned, the run goes on.
+            Err(Failure::Input(message)) => Ok(Err(message)),
+            Err(other) => Err(other),
+        }
     };
-    let records: Vec<Record> = if args.serial {
+    let outcomes: Vec<Result<Record, String>> = if args.serial {
         jobs.iter().map(one).collect::<Result<_, _>>()?
     } else {
         jobs.par_iter().map(one).collect::<Result<_, _>>()?
     };
     bar.finish_and_clear();
+    let (records, refused): (Vec<_>, Vec<_>) = outcomes.into_iter().partition(Result::is_ok);
+    let records: Vec<Record> = records.into_iter().filter_map(Result::ok).collect();
+    let refused: Vec<String> = refused.into_iter().filter_map(Result::err).collect();
     write_outputs(&args.out, &label, &records).map_err(input)?;
     print!("{}", summary(&label, &records));
+    if !refused.is_empty() {
+        let path = args.out.join("refused.txt");
+        std::fs::write(&path, refused.join("\n") + "\n").map_err(|e| input(format!("{}: {e}", path.display())))?;
+        println!(
+            "\n{} problems refused as invalid input, not planned: {}",
+            refused.len(),
+            path.display()
+        );
+    }
     Ok(())
 }
 

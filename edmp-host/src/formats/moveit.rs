@@ -625,13 +625,6 @@ fn collision_object(v: &Value, path: &str, frames: ObjectFrames<'_>) -> R<(Strin
         let placed = object_pose * pose(Some(p), &format!("{mpp}[{i}]"))?;
         out.push(mesh(m, &format!("{mp}[{i}]"), &placed)?);
     }
-    if !out.is_empty() {
-        // Read and checked; `out` keeps them once the scene reader takes mesh obstacles.
-        return Err(at(
-            &mp,
-            "not supported: meshes (mesh obstacles are not yet supported by edmp-scene/1; cuboid, sphere, cylinder primitives only)",
-        ));
-    }
     let (primitives, pp) = sequence(map, path, "primitives")?;
     let (poses, posep) = sequence(map, path, "primitive_poses")?;
     if primitives.len() != poses.len() {

@@ -2,6 +2,7 @@
 //! [`add_trajectory`] for the timed `trajectory`) and the one reader ([`parse_plan`]), which
 //! the CLI, the viewer and the Python package share.
 
+use super::surface::SurfaceKind;
 use crate::Failure;
 use crate::formats::json::{InputError, Problem, field, number, numbers};
 use crate::formats::trajectory::{TimedRequest, trajectory_document};
@@ -68,6 +69,18 @@ pub fn plan_document(
             "shortcut": planned.shortcut_ms,
         },
     });
+    let filtering = problem.surfaces.obstacles.iter().any(|o| {
+        matches!(
+            o.kind,
+            SurfaceKind::Points {
+                filter_robot: Some(_),
+                ..
+            }
+        )
+    });
+    if filtering {
+        out["points_filtered"] = json!(problem.surfaces.points_filtered);
+    }
     if candidates {
         out["candidates"] = plan
             .paths
