@@ -5,8 +5,6 @@
 
 use crate::robot::{FINGER_OPENING_DEFAULT, FINGER_OPENING_MAX, FINGER_OPENING_MIN};
 use crate::surface::Surface;
-#[cfg(doc)]
-use crate::surface::cover;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 /// Default obstacle capacity of a [`Scene`].
@@ -164,7 +162,7 @@ pub fn rotation_from_wxyz(q: [f32; 4]) -> Result<Matrix3<f32>, SceneError> {
 
 impl Obstacle {
     /// A unit ball at the origin: fills fixed arrays before they are written
-    /// (e.g. the output of [`cover::covers`]).
+    /// (e.g. the output of [`crate::cost::cover::covers`]).
     pub const PLACEHOLDER: Self = Self {
         shape: Shape::Sphere { radius: 1.0 },
         center: Vector3::new(0.0, 0.0, 0.0),
@@ -287,7 +285,7 @@ impl<'a, const N: usize> Scene<'a, N> {
     }
 
     /// This scene with `surface`'s pieces as obstacles: the checker takes them exactly, the
-    /// guides take `boxes` around them ([`cover::covers`]), as many as the scene's capacity
+    /// guides take `boxes` around them ([`crate::cost::cover::covers`]), as many as the scene's capacity
     /// leaves room for. Any earlier surface and its boxes are replaced.
     pub fn with_surface<'b>(self, surface: Surface<'b>, boxes: &[Obstacle]) -> Scene<'b, N> {
         let mut obstacles = self.obstacles;

@@ -2,10 +2,12 @@
 //!
 //! A support function maps a direction `d` to a point of the shape that is farthest along `d`.
 //! Every shape here is exact: a robot body is the convex hull of its collision-mesh vertices
-//! (what PyBullet uses too), obstacles are true cuboids, spheres and cylinders.
+//! (what PyBullet uses too), obstacles are true cuboids, spheres and cylinders, and the balls
+//! and triangles of clouds and meshes.
 
 use crate::robot::kinematics::Pose;
 use crate::scene::{Obstacle, Shape};
+use crate::surface::element::{Element, Piece};
 use nalgebra::{Matrix3, Vector3};
 
 /// A convex set known through its support function.
@@ -136,6 +138,29 @@ impl Convex for Solid {
     }
 }
 
+impl Convex for Element {
+    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
+        match &self.piece {
+            Piece::Ball { center, radius } => {
+                let n = crate::float::sqrt(d.norm_squared());
+                if n > 0.0 { center + d * (radius / n) } else { *center }
+            }
+            Piece::Triangle { corners } => {
+                let mut best = corners[0];
+                let mut best_dot = best.dot(d);
+                for c in &corners[1..] {
+                    let dot = c.dot(d);
+                    if dot > best_dot {
+                        best_dot = dot;
+                        best = *c;
+                    }
+                }
+                best
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -149,5 +174,11 @@ mod tests {
         assert!((s.support(&Vector3::new(0.0, 0.0, -3.0)) - Vector3::new(0.0, 1.0, -0.5)).norm() < 1e-7);
         let c = Solid::obstacle(&Obstacle::cylinder([0.0; 3], 0.1, 0.4, id).unwrap());
         assert!((c.support(&Vector3::new(3.0, 4.0, 1.0)) - Vector3::new(0.06, 0.08, 0.2)).norm() < 1e-6);
+        let t = Element::triangle([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], 0)
+            .unwrap()
+            .unwrap();
+        assert_eq!(t.support(&Vector3::new(1.0, 0.1, 0.0)), Vector3::new(1.0, 0.0, 0.0));
+        let ball = Element::ball([1.0, 0.0, 0.0], 0.5, 0).unwrap();
+        assert!((ball.support(&Vector3::new(0.0, 0.0, 2.0)) - Vector3::new(1.0, 0.0, 0.5)).norm() < 1e-7);
     }
 }

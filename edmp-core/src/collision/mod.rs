@@ -5,7 +5,9 @@
 //! - [`gjk`]: the distance between two convex sets (GJK), with its witness direction.
 //! - [`checker`]: states, segments and whole trajectories against the scene, with the
 //!   margins near the ends and the steps that [`crate::robot::reach`] bounds.
+//! - [`filter`]: the robot's own points dropped from a cloud.
 
 pub mod checker;
 pub mod convex;
+pub mod filter;
 pub mod gjk;

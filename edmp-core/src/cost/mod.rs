@@ -19,6 +19,7 @@
 
 pub mod boxes;
 pub mod clearance;
+pub mod cover;
 
 use crate::cost::boxes::{Aabb, BoxFrame, CylinderBox, Inflation, box_dims, inflated_dims, obstacle_aabb};
 use crate::error::Error;

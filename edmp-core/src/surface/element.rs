@@ -1,7 +1,7 @@
 //! The pieces a surface is made of: a ball around one point of a cloud, or one triangle of a
-//! mesh. Each is a convex set, so the checker's GJK takes it as it takes a primitive.
+//! mesh. Each is a convex set, so the checker's GJK takes it as it takes a primitive (its
+//! support function is in `collision::convex`).
 
-use crate::collision::convex::Convex;
 use nalgebra::Vector3;
 
 /// Why a cloud or a mesh was refused.
@@ -175,29 +175,6 @@ impl Element {
     }
 }
 
-impl Convex for Element {
-    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
-        match &self.piece {
-            Piece::Ball { center, radius } => {
-                let n = crate::float::sqrt(d.norm_squared());
-                if n > 0.0 { center + d * (radius / n) } else { *center }
-            }
-            Piece::Triangle { corners } => {
-                let mut best = corners[0];
-                let mut best_dot = best.dot(d);
-                for c in &corners[1..] {
-                    let dot = c.dot(d);
-                    if dot > best_dot {
-                        best_dot = dot;
-                        best = *c;
-                    }
-                }
-                best
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -215,7 +192,6 @@ mod tests {
             .unwrap()
             .unwrap();
         assert_eq!(t.obstacle, 3);
-        assert_eq!(t.support(&Vector3::new(1.0, 0.1, 0.0)), Vector3::new(1.0, 0.0, 0.0));
         let b = t.bounds();
         assert_eq!((b.lo, b.hi), (Vector3::zeros(), Vector3::new(1.0, 1.0, 0.0)));
     }

@@ -4,14 +4,16 @@
 //!
 //! - [`element`]: a piece (a ball or a triangle) and the obstacle it came from.
 //! - [`bvh`]: the static hierarchy the checker walks to find the pieces near a body.
-//! - [`cover`]: a few boxes around the pieces, for the guides (EDMP's costs are box volumes).
-//! - [`points`]: a cloud reduced to a capacity, conservatively; the robot's own points dropped.
+//! - [`points`]: a cloud reduced to a capacity, conservatively.
+//!
+//! Above the scene, `collision::filter` drops the robot's own points from a cloud and
+//! `cost::cover` fits the few boxes the guides see around the pieces (EDMP's costs are box
+//! volumes).
 //!
 //! A [`Surface`] is a borrowed view of built buffers: the host builds it from files, firmware
 //! receives it built (the tree is part of the wire).
 
 pub mod bvh;
-pub mod cover;
 pub mod element;
 pub mod points;
 

@@ -1,17 +1,9 @@
-//! A cloud made small enough to hold, and the robot's own points taken out of it.
-//!
-//! [`reduce`] keeps every point while they fit; beyond the capacity it replaces the points of
-//! each cell of a grid by one ball at the cell's centre, grown by the cell's half diagonal, so
-//! the reduced balls still cover every input ball (conservative, never truncated).
-//! [`filter_robot`] drops the points a camera saw on the arm itself.
+//! A cloud made small enough to hold: [`reduce`] keeps every point while they fit; beyond the
+//! capacity it replaces the points of each cell of a grid by one ball at the cell's centre,
+//! grown by the cell's half diagonal, so the reduced balls still cover every input ball
+//! (conservative, never truncated).
 
-use crate::collision::convex::{Convex, Hull};
-use crate::collision::gjk::distance_lower_bound;
-use crate::error::Error;
-use crate::robot::kinematics::{Joints, forward_with};
-use crate::robot::{BODIES, FRAMES, PANDA};
 use crate::surface::element::SurfaceError;
-use nalgebra::Vector3;
 
 /// How a cloud was held: the points kept and the radius of their balls.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,57 +88,10 @@ pub fn reduce(points: &mut [[f32; 3]], radius: f32, capacity: usize) -> Result<R
     Err(SurfaceError::TooManyPieces)
 }
 
-/// A point, as a convex set.
-struct Point(Vector3<f32>);
-
-impl Convex for Point {
-    fn support(&self, _: &Vector3<f32>) -> Vector3<f32> {
-        self.0
-    }
-}
-
-/// Drops the points within `distance` of the robot's collision bodies (link0 included) at
-/// configuration `q` with the fingers at `finger`; the kept points move to the front. Returns
-/// how many were kept.
-pub fn filter_robot(points: &mut [[f32; 3]], q: &Joints<f32>, finger: f32, distance: f32) -> Result<usize, Error> {
-    if !(distance.is_finite() && distance >= 0.0) {
-        return Err(Error::BadParameter);
-    }
-    let k = forward_with(q, finger)?;
-    let bodies: [(Vector3<f32>, f32); BODIES] = core::array::from_fn(|b| {
-        let body = &PANDA.bodies[b];
-        (
-            k.boxes[b].translation,
-            crate::float::sqrt(body.half_extents.norm_squared()),
-        )
-    });
-    let mut kept = 0;
-    for i in 0..points.len() {
-        let Some(&p) = points.get(i) else { break };
-        let v = Vector3::from(p);
-        let own = bodies.iter().enumerate().any(|(b, (c, r))| {
-            if (v - c).norm_squared() > (r + distance) * (r + distance) {
-                return false;
-            }
-            let hull = Hull {
-                pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
-                points: PANDA.hull(b),
-            };
-            distance_lower_bound(&hull, &Point(v)) <= distance
-        });
-        if !own {
-            if let Some(slot) = points.get_mut(kept) {
-                *slot = p;
-            }
-            kept += 1;
-        }
-    }
-    Ok(kept)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector3;
     use std::vec::Vec;
 
     #[test]
@@ -170,18 +115,5 @@ mod tests {
         assert_eq!(reduce(&mut few, 0.0075, 100).unwrap().points, 100);
         assert_eq!(few, input[..100]);
         assert_eq!(reduce(&mut few, 0.0, 10), Err(SurfaceError::NonPositiveRadius));
-    }
-
-    #[test]
-    fn the_robots_own_points_are_dropped() {
-        let ready = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-        let k = forward_with(&ready, 0.025).unwrap();
-        let tcp = k.tcp().translation;
-        // One point at the hand's origin (on the robot), one 1 m away.
-        let hand = k.frames[crate::robot::HAND_FRAME].translation;
-        let mut points = [[hand.x, hand.y, hand.z], [tcp.x + 1.0, tcp.y, tcp.z]];
-        assert_eq!(filter_robot(&mut points, &ready, 0.025, 0.01).unwrap(), 1);
-        assert_eq!(points[0], [tcp.x + 1.0, tcp.y, tcp.z]);
-        assert!(filter_robot(&mut points, &ready, 0.025, f32::NAN).is_err());
     }
 }

@@ -4,7 +4,8 @@
 
 use super::surface::SurfaceKind;
 use crate::Failure;
-use crate::formats::json::{InputError, Problem, field, number, numbers};
+use crate::formats::fields::{InputError, field, number, numbers};
+use crate::formats::json::Problem;
 use crate::formats::trajectory::{TimedRequest, trajectory_document};
 use crate::planning::{Planned, ROWS};
 use edmp_core::cost::boxes::Inflation;

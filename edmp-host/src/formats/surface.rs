@@ -3,16 +3,17 @@
 //! points dropped, a cloud reduced when it exceeds the capacity, and built into the buffers a
 //! core [`Surface`] borrows.
 
+use super::fields::{InputError, field, number, numbers, object, quaternion};
 use super::file_error::FileError;
-use super::json::{InputError, field, number, numbers, object, quaternion};
 use super::{cloud, mesh_file};
+use edmp_core::collision::filter::filter_robot;
+use edmp_core::cost::cover::covers;
 use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::{Obstacle, rotation_from_wxyz};
 use edmp_core::surface::Surface;
 use edmp_core::surface::bvh::{Node, build, nodes_for};
-use edmp_core::surface::cover::covers;
 use edmp_core::surface::element::{Element, SurfaceError};
-use edmp_core::surface::points::{Reduced, filter_robot, reduce};
+use edmp_core::surface::points::{Reduced, reduce};
 use nalgebra::{Matrix3, Vector3};
 use serde_json::Value;
 use std::path::Path;

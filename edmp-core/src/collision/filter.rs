@@ -1,0 +1,75 @@
+//! The robot's own points taken out of a cloud: a camera that sees the cell sees the arm too,
+//! and those points would put every start in collision.
+
+use crate::collision::convex::{Convex, Hull};
+use crate::collision::gjk::distance_lower_bound;
+use crate::error::Error;
+use crate::robot::kinematics::{Joints, forward_with};
+use crate::robot::{BODIES, FRAMES, PANDA};
+use nalgebra::Vector3;
+
+/// A point, as a convex set.
+struct Point(Vector3<f32>);
+
+impl Convex for Point {
+    fn support(&self, _: &Vector3<f32>) -> Vector3<f32> {
+        self.0
+    }
+}
+
+/// Drops the points within `distance` of the robot's collision bodies (link0 included) at
+/// configuration `q` with the fingers at `finger`; the kept points move to the front. Returns
+/// how many were kept.
+pub fn filter_robot(points: &mut [[f32; 3]], q: &Joints<f32>, finger: f32, distance: f32) -> Result<usize, Error> {
+    if !(distance.is_finite() && distance >= 0.0) {
+        return Err(Error::BadParameter);
+    }
+    let k = forward_with(q, finger)?;
+    let bodies: [(Vector3<f32>, f32); BODIES] = core::array::from_fn(|b| {
+        let body = &PANDA.bodies[b];
+        (
+            k.boxes[b].translation,
+            crate::float::sqrt(body.half_extents.norm_squared()),
+        )
+    });
+    let mut kept = 0;
+    for i in 0..points.len() {
+        let Some(&p) = points.get(i) else { break };
+        let v = Vector3::from(p);
+        let own = bodies.iter().enumerate().any(|(b, (c, r))| {
+            if (v - c).norm_squared() > (r + distance) * (r + distance) {
+                return false;
+            }
+            let hull = Hull {
+                pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
+                points: PANDA.hull(b),
+            };
+            distance_lower_bound(&hull, &Point(v)) <= distance
+        });
+        if !own {
+            if let Some(slot) = points.get_mut(kept) {
+                *slot = p;
+            }
+            kept += 1;
+        }
+    }
+    Ok(kept)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_robots_own_points_are_dropped() {
+        let ready = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
+        let k = forward_with(&ready, 0.025).unwrap();
+        let tcp = k.tcp().translation;
+        // One point at the hand's origin (on the robot), one 1 m away.
+        let hand = k.frames[crate::robot::HAND_FRAME].translation;
+        let mut points = [[hand.x, hand.y, hand.z], [tcp.x + 1.0, tcp.y, tcp.z]];
+        assert_eq!(filter_robot(&mut points, &ready, 0.025, 0.01).unwrap(), 1);
+        assert_eq!(points[0], [tcp.x + 1.0, tcp.y, tcp.z]);
+        assert!(filter_robot(&mut points, &ready, 0.025, f32::NAN).is_err());
+    }
+}
