@@ -54,16 +54,7 @@ fn nearest_other(q: &[f32; 7], b: usize, p: &Element) -> f32 {
 }
 
 fn checked(pieces: &mut [Element], q: &[f32; 7]) -> Option<Contact> {
-    let mut nodes = vec![
-        Node {
-            lo: [0.0; 3],
-            hi: [0.0; 3],
-            first: 0,
-            count: 0,
-            left: 0
-        };
-        nodes_for(pieces.len())
-    ];
+    let mut nodes = vec![Node::EMPTY; nodes_for(pieces.len())];
     let used = build(pieces, &mut nodes).unwrap();
     let surface = Surface::new(pieces, &nodes[..used]).unwrap();
     let scene = Scene::<4>::new().with_surface(surface, &[]);

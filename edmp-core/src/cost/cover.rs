@@ -114,7 +114,7 @@ mod tests {
                 Element::ball([0.6 + u * c, u * s, z], 0.0075, 0).unwrap()
             })
             .collect();
-        let mut nodes = std::vec![Node { lo: [0.0; 3], hi: [0.0; 3], first: 0, count: 0, left: 0 }; nodes_for(5000)];
+        let mut nodes = std::vec![Node::EMPTY; nodes_for(5000)];
         let used = build(&mut pieces, &mut nodes).unwrap();
         let surface = Surface::new(&pieces, &nodes[..used]).unwrap();
         let mut out = [Obstacle::sphere([0.0; 3], 1.0).unwrap(); 1];

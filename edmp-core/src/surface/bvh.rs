@@ -29,6 +29,15 @@ pub struct Node {
 }
 
 impl Node {
+    /// A node with nothing in it: fills node buffers before [`build`] writes them.
+    pub const EMPTY: Self = Self {
+        lo: [0.0; 3],
+        hi: [0.0; 3],
+        first: 0,
+        count: 0,
+        left: 0,
+    };
+
     /// The node's box.
     pub fn bounds(&self) -> Aabb {
         Aabb {
@@ -131,7 +140,7 @@ mod tests {
                 Element::ball([libm::sinf(f) * 0.5, libm::cosf(f * 1.3) * 0.4, f * 1e-3], 0.01, 0).unwrap()
             })
             .collect();
-        let mut nodes = std::vec![Node { lo: [0.0; 3], hi: [0.0; 3], first: 0, count: 0, left: 0 }; nodes_for(1000)];
+        let mut nodes = std::vec![Node::EMPTY; nodes_for(1000)];
         let used = build(&mut pieces, &mut nodes).unwrap();
         assert!(used < 1000);
         let mut covered = 0;

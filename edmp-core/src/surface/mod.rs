@@ -182,8 +182,7 @@ mod tests {
         let mut pieces: Vec<Element> = (0..10_000)
             .map(|i| Element::ball([0.5, (i % 100) as f32 * 0.01 - 0.5, (i / 100) as f32 * 0.01], 0.0075, 2).unwrap())
             .collect();
-        let mut nodes =
-            std::vec![Node { lo: [0.0; 3], hi: [0.0; 3], first: 0, count: 0, left: 0 }; bvh::nodes_for(pieces.len())];
+        let mut nodes = std::vec![Node::EMPTY; bvh::nodes_for(pieces.len())];
         let used = bvh::build(&mut pieces, &mut nodes).unwrap();
         nodes.truncate(used);
         (pieces, nodes)

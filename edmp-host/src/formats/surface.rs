@@ -342,16 +342,7 @@ pub fn build_surfaces(
             }
         }
     }
-    let mut nodes = vec![
-        Node {
-            lo: [0.0; 3],
-            hi: [0.0; 3],
-            first: 0,
-            count: 0,
-            left: 0
-        };
-        nodes_for(pieces.len())
-    ];
+    let mut nodes = vec![Node::EMPTY; nodes_for(pieces.len())];
     let used = if pieces.is_empty() {
         0
     } else {
