@@ -211,9 +211,22 @@ def test_moveit_scene_and_request_import_and_plan(wall: edmp.Scene) -> None:
     np.testing.assert_array_equal(alone.goal, alone.start)
 
 
-def test_moveit_meshes_are_an_error_naming_the_yaml_path() -> None:
-    with pytest.raises(edmp.SceneError, match=r"world\.collision_objects\[1\]\.meshes: not supported"):
-        edmp.import_moveit(MOVEIT / "mesh.scene.yaml")
+def test_moveit_meshes_become_mesh_obstacles() -> None:
+    scene = edmp.import_moveit(MOVEIT / "mesh.scene.yaml", MOVEIT / "joint_goal.request.yaml")
+    assert [o["type"] for o in scene.obstacles].count("mesh") == 1
+
+
+def test_cloud_files_are_read_beside_the_scene_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    doc = json.loads((ROOT / "examples" / "wall.json").read_text())
+    points = np.array([[1.5, y, z] for y in (-0.1, 0.0, 0.1) for z in (0.2, 0.3)], dtype="<f4")
+    header = f"ply\nformat binary_little_endian 1.0\nelement vertex {len(points)}\n"
+    header += "property float x\nproperty float y\nproperty float z\nend_header\n"
+    (tmp_path / "far.ply").write_bytes(header.encode() + points.tobytes())
+    doc["obstacles"].append({"type": "points", "file": "far.ply", "radius": 0.01})
+    (tmp_path / "scene.json").write_text(json.dumps(doc))
+    monkeypatch.chdir(ROOT)
+    scene = edmp.Scene.from_file(tmp_path / "scene.json")
+    assert edmp.plan(scene, seed=0).status == "success"
 
 
 def test_the_gripper_opening_is_part_of_the_problem() -> None:

@@ -136,11 +136,22 @@ class Scene:
 
     @classmethod
     def from_file(cls, path: Union[str, os.PathLike[str]]) -> "Scene":
-        """A scene from an ``edmp-scene/1`` JSON file."""
+        """A scene from an ``edmp-scene/1`` JSON file. The cloud and mesh files its obstacles
+        name are relative to the file's folder, as for ``edmp-host plan``: they are made
+        absolute here, so the scene plans from any working directory."""
         with open(path, encoding="utf-8") as f:
             text = f.read()
         try:
-            return cls.from_json(text)
+            doc = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise SceneError(f"{os.fspath(path)}: not valid JSON: {e}") from None
+        folder = os.path.dirname(os.path.abspath(path))
+        obstacles = doc.get("obstacles") if isinstance(doc, dict) else None
+        for o in obstacles if isinstance(obstacles, list) else []:
+            if isinstance(o, dict) and isinstance(o.get("file"), str) and not os.path.isabs(o["file"]):
+                o["file"] = os.path.join(folder, o["file"])
+        try:
+            return cls.from_dict(doc)
         except SceneError as e:
             raise SceneError(f"{os.fspath(path)}: {e}") from None
 
@@ -488,7 +499,7 @@ def import_moveit(
     """A MoveIt planning scene (``moveit_msgs/PlanningScene`` YAML) and optionally a motion
     plan request (``moveit_msgs/MotionPlanRequest`` YAML) as a :class:`Scene`, as
     ``edmp-host import-moveit``. Each argument is YAML text or a path to a file. Unsupported
-    entries (meshes, planes, other frames or links...) raise :class:`SceneError` naming their
+    entries (octomaps, point clouds, planes, other frames or links...) raise :class:`SceneError` naming their
     YAML path. Without a request the start is the scene's robot state and the goal equals it
     (set one with :meth:`Scene.with_goal`)."""
 
