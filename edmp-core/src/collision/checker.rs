@@ -21,7 +21,8 @@ use crate::robot::kinematics::{Joints, Kinematics, forward_with};
 use crate::robot::reach::{BODY_REACH, HAND_REACH, motion};
 use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
 use crate::scene::{Scene, Shape};
-use crate::surface::element::{Element, Piece};
+use crate::surface::Probe;
+use crate::surface::element::{Aabb, Element, Piece};
 use core::cmp::Ordering;
 use nalgebra::{Matrix3, Vector3};
 
@@ -487,17 +488,20 @@ impl<'s, const N: usize> Prepared<'s, N> {
             let slack = &mut self.slack.surface[b % SLOTS];
             if !surface.is_empty() && *slack <= 0.0 {
                 let hint = &mut self.hints.surface[b % SLOTS];
-                let gap = surface.gap(
-                    &center[b % SLOTS],
-                    self.radius[b % SLOTS],
-                    margin,
-                    SURFACE_HORIZON,
-                    |e| {
-                        placed
-                            .ball_clear_of_box(b, e, margin)
-                            .or_else(|| placed.body_apart_from(b, e, hint))
-                    },
-                );
+                let around = match (k.boxes.get(b), &held) {
+                    (Some(pose), _) => Aabb::around_box(
+                        &pose.translation,
+                        &pose.rotation,
+                        &PANDA.bodies[b % BODIES].half_extents,
+                    ),
+                    _ => Aabb::around_ball(&center[b % SLOTS], self.radius[b % SLOTS]),
+                };
+                let gap = surface.gap(&around, margin, SURFACE_HORIZON, |probe| match probe {
+                    Probe::Piece(e) => placed
+                        .ball_clear_of_box(b, e, margin)
+                        .or_else(|| placed.body_apart_from(b, e, hint)),
+                    Probe::Box(aabb) => placed.body_apart_from(b, &Solid::aabb(aabb), hint),
+                });
                 match gap {
                     Ok(gap) => *slack = gap - carry,
                     Err(obstacle) => {
@@ -582,18 +586,19 @@ pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f3
             pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
             points: PANDA.hull(b),
         };
-        let (center, radius) = (
-            k.boxes[b].translation,
-            crate::float::sqrt(PANDA.bodies[b].half_extents.norm_squared()),
-        );
-        let gap = surface.gap(&center, radius, f32::INFINITY, best, |e| {
-            Some(distance_lower_bound(&hull, e))
+        let pose = &k.boxes[b];
+        let around = Aabb::around_box(&pose.translation, &pose.rotation, &PANDA.bodies[b].half_extents);
+        let gap = surface.gap(&around, f32::INFINITY, best, |probe| match probe {
+            Probe::Piece(e) => Some(distance_lower_bound(&hull, e)),
+            Probe::Box(_) => None,
         });
         best = best.min(gap.unwrap_or(0.0));
     }
     if let Some(h) = &held {
-        let gap = surface.gap(&h.center, h.bounding_radius(), f32::INFINITY, best, |e| {
-            Some(distance_lower_bound(h, e))
+        let around = Aabb::around_ball(&h.center, h.bounding_radius());
+        let gap = surface.gap(&around, f32::INFINITY, best, |probe| match probe {
+            Probe::Piece(e) => Some(distance_lower_bound(h, e)),
+            Probe::Box(_) => None,
         });
         best = best.min(gap.unwrap_or(0.0));
     }

@@ -7,7 +7,7 @@
 
 use crate::robot::kinematics::Pose;
 use crate::scene::{Obstacle, Shape};
-use crate::surface::element::{Element, Piece};
+use crate::surface::element::{Aabb, Element, Piece};
 use nalgebra::{Matrix3, Vector3};
 
 /// A convex set known through its support function.
@@ -84,6 +84,15 @@ impl Solid {
             shape: Shape::Cuboid { dims: half * 2.0 },
             rotation: pose.rotation,
             center: pose.translation,
+        }
+    }
+
+    /// An axis-aligned box (a subtree of a surface, proven clear at once).
+    pub fn aabb(b: &Aabb) -> Self {
+        Self {
+            shape: Shape::Cuboid { dims: b.hi - b.lo },
+            rotation: Matrix3::identity(),
+            center: (b.lo + b.hi) * 0.5,
         }
     }
 

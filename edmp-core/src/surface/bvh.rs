@@ -3,7 +3,7 @@
 //! a node's children sit side by side in the node buffer. Median splits along the longest axis
 //! of the centroids keep the depth at about log₂ of the piece count.
 
-use crate::surface::element::{Aabb, Element, SurfaceError};
+use crate::surface::element::{Aabb, Element, Piece, SurfaceError};
 
 /// A leaf holds at most this many pieces.
 pub const LEAF: usize = 4;
@@ -53,6 +53,38 @@ pub const fn nodes_for(pieces: usize) -> usize {
     if pieces == 0 { 1 } else { pieces }
 }
 
+/// One pass over a run: the box of its pieces, and the box of their centroids (where it is
+/// split). Plain arrays: this loop is most of a build's time.
+fn boxes_of(run: &[Element]) -> (Aabb, Aabb) {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let (mut clo, mut chi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for e in run {
+        let (elo, ehi, c) = match &e.piece {
+            Piece::Ball { center, radius } => {
+                let c = [center.x, center.y, center.z];
+                (c.map(|x| x - radius), c.map(|x| x + radius), c)
+            }
+            Piece::Triangle { corners: [a, b, c] } => {
+                let lo = [a.x.min(b.x).min(c.x), a.y.min(b.y).min(c.y), a.z.min(b.z).min(c.z)];
+                let hi = [a.x.max(b.x).max(c.x), a.y.max(b.y).max(c.y), a.z.max(b.z).max(c.z)];
+                let m = (a + b + c) / 3.0;
+                (lo, hi, [m.x, m.y, m.z])
+            }
+        };
+        for k in 0..3 {
+            lo[k] = lo[k].min(elo[k]);
+            hi[k] = hi[k].max(ehi[k]);
+            clo[k] = clo[k].min(c[k]);
+            chi[k] = chi[k].max(c[k]);
+        }
+    }
+    let aabb = |lo: [f32; 3], hi: [f32; 3]| Aabb {
+        lo: lo.into(),
+        hi: hi.into(),
+    };
+    (aabb(lo, hi), aabb(clo, chi))
+}
+
 /// Moves the pieces for which `left` holds to the front, keeping no order; returns how many.
 fn partition(run: &mut [Element], left: impl Fn(&Element) -> bool) -> usize {
     let mut front = 0;
@@ -85,11 +117,7 @@ pub fn build(pieces: &mut [Element], nodes: &mut [Node]) -> Result<usize, Surfac
         let Some(run) = pieces.get_mut(first..first + count) else {
             return Err(SurfaceError::TooManyPieces);
         };
-        // One pass: the run's box, and the box of its centroids (where it is split).
-        let (b, c) = run.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), e| {
-            let p = e.centroid();
-            (b.union(&e.bounds()), c.union(&Aabb { lo: p, hi: p }))
-        });
+        let (b, c) = boxes_of(run);
         let mut node = Node {
             lo: b.lo.into(),
             hi: b.hi.into(),

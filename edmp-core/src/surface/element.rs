@@ -70,6 +70,33 @@ impl Aabb {
         d2
     }
 
+    /// Squared distance between the two boxes (0 when they overlap).
+    pub fn distance_squared_to(&self, other: &Self) -> f32 {
+        let mut d2 = 0.0;
+        for k in 0..3 {
+            let d = (self.lo[k] - other.hi[k]).max(other.lo[k] - self.hi[k]).max(0.0);
+            d2 += d * d;
+        }
+        d2
+    }
+
+    /// The box around a ball.
+    pub fn around_ball(center: &Vector3<f32>, radius: f32) -> Self {
+        Self {
+            lo: center.add_scalar(-radius),
+            hi: center.add_scalar(radius),
+        }
+    }
+
+    /// The box around a box with half extents `half` turned by `rotation` about `center`.
+    pub fn around_box(center: &Vector3<f32>, rotation: &nalgebra::Matrix3<f32>, half: &Vector3<f32>) -> Self {
+        let reach = rotation.abs() * half;
+        Self {
+            lo: center - reach,
+            hi: center + reach,
+        }
+    }
+
     /// Volume (0 for the empty box).
     pub fn volume(&self) -> f32 {
         let d = self.hi - self.lo;

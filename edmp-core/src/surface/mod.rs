@@ -20,7 +20,18 @@ pub mod points;
 use crate::float::sqrt_below;
 use bvh::{MAX_DEPTH, Node};
 use element::{Aabb, Element, Piece, SurfaceError};
-use nalgebra::Vector3;
+
+/// Subtrees of at most this many pieces are offered to a proof as one box first.
+pub const BOX_PROOF: usize = 32;
+
+/// What [`Surface::gap`] asks its caller to prove clear.
+#[derive(Clone, Copy, Debug)]
+pub enum Probe<'p> {
+    /// One piece.
+    Piece(&'p Element),
+    /// The box holding a subtree's pieces: clear of it means clear of them all.
+    Box(&'p Aabb),
+}
 
 /// The pieces of every cloud and mesh of a scene, and the tree over them.
 #[derive(Clone, Copy, Debug)]
@@ -85,6 +96,13 @@ impl<'a> Surface<'a> {
         Ok(Self { pieces, nodes })
     }
 
+    /// A view of buffers [`bvh::build`] has just filled, without [`Surface::new`]'s walk over
+    /// every piece (a host that keeps the buffers private to itself calls this on every plan).
+    /// A tree not made by `build` over these pieces gives wrong verdicts, never a panic.
+    pub fn from_built(pieces: &'a [Element], nodes: &'a [Node]) -> Self {
+        Self { pieces, nodes }
+    }
+
     /// The pieces, in the tree's order.
     pub fn pieces(&self) -> &'a [Element] {
         self.pieces
@@ -103,19 +121,20 @@ impl<'a> Surface<'a> {
     /// A certified lower bound on the distance from a convex shape to every piece, capped at
     /// `horizon`; `Err(obstacle)` names a piece's obstacle that is not proven clear.
     ///
-    /// The shape lies in the ball of `radius` around `center`. A subtree or a piece whose box
-    /// the ball's distance alone proves more than `near` away counts with that bound (and a
-    /// subtree is not opened); only the pieces nearer go to `prove`, which returns the
-    /// certified gap (above the caller's margin) or `None`.
-    pub fn gap<F>(&self, center: &Vector3<f32>, radius: f32, near: f32, horizon: f32, mut prove: F) -> Result<f32, u16>
+    /// The shape lies in the axis-aligned box `shape`. A subtree or a piece whose box that
+    /// box's distance alone proves more than `near` away counts with that bound (and a subtree
+    /// is not opened); only the pieces nearer go to `prove`, which returns the certified gap
+    /// (above the caller's margin) or `None`. A small subtree near the shape is first offered
+    /// whole, as its box ([`Probe::Box`]): one proof for up to [`BOX_PROOF`] pieces.
+    pub fn gap<F>(&self, shape: &Aabb, near: f32, horizon: f32, mut prove: F) -> Result<f32, u16>
     where
-        F: FnMut(&Element) -> Option<f32>,
+        F: FnMut(Probe<'_>) -> Option<f32>,
     {
         let mut best = horizon;
         let Some(root) = self.nodes.first() else {
             return Ok(best);
         };
-        let bound = |b: &Aabb| sqrt_below(b.distance_squared(center)) - radius;
+        let bound = |b: &Aabb| sqrt_below(b.distance_squared_to(shape));
         let mut todo = [0u32; MAX_DEPTH + 2];
         let mut depth = 0usize;
         let mut node = *root;
@@ -125,13 +144,18 @@ impl<'a> Surface<'a> {
                 // The box alone proves the whole subtree clear: its bound stands for it.
                 best = lb;
             } else if lb < best {
-                if node.left == 0 {
+                let boxed = if node.count as usize <= BOX_PROOF && node.count > 1 {
+                    prove(Probe::Box(&node.bounds()))
+                } else {
+                    None
+                };
+                if let Some(gap) = boxed {
+                    best = best.min(gap);
+                } else if node.left == 0 {
                     let end = node.first as usize + node.count as usize;
                     for e in self.pieces.get(node.first as usize..end).unwrap_or(&[]) {
                         let lb = match e.piece {
-                            Piece::Ball { center: c, radius: r } => {
-                                sqrt_below((c - center).norm_squared()) - radius - r
-                            }
+                            Piece::Ball { center: c, radius: r } => sqrt_below(shape.distance_squared(&c)) - r,
                             Piece::Triangle { .. } => bound(&e.bounds()),
                         };
                         if lb >= best {
@@ -140,7 +164,7 @@ impl<'a> Surface<'a> {
                         best = if lb > near {
                             lb
                         } else {
-                            prove(e).ok_or(e.obstacle)?.min(best)
+                            prove(Probe::Piece(e)).ok_or(e.obstacle)?.min(best)
                         };
                     }
                 } else if let (Some(a), Some(b)) = (todo.get_mut(depth), self.nodes.get(node.left as usize)) {
@@ -175,6 +199,7 @@ mod tests {
     use crate::collision::convex::Solid;
     use crate::collision::gjk::distance_lower_bound;
     use crate::scene::Obstacle;
+    use nalgebra::Vector3;
     use std::vec::Vec;
 
     fn cloud() -> (Vec<Element>, Vec<Node>) {
@@ -188,6 +213,15 @@ mod tests {
         (pieces, nodes)
     }
 
+    /// The box around a 5 cm ball at `(x, 0, 0.5)`.
+    fn around(x: f32) -> Aabb {
+        let c = Vector3::new(x, 0.0, 0.5);
+        Aabb {
+            lo: c.add_scalar(-0.05),
+            hi: c.add_scalar(0.05),
+        }
+    }
+
     #[test]
     fn the_gap_is_the_distance_to_the_nearest_ball_and_contact_names_the_obstacle() {
         let (pieces, nodes) = cloud();
@@ -198,19 +232,23 @@ mod tests {
             (0.9, 0.4 - 0.0075 - 0.05),
         ] {
             let ball = Solid::obstacle(&Obstacle::sphere([x, 0.0, 0.5], 0.05).unwrap());
-            let c = Vector3::new(x, 0.0, 0.5);
             let g = s
-                .gap(&c, 0.05, 0.002, 0.1, |e| Some(distance_lower_bound(&ball, e)))
+                .gap(&around(x), 0.002, 0.1, |p| match p {
+                    Probe::Piece(e) => Some(distance_lower_bound(&ball, e)),
+                    Probe::Box(_) => None,
+                })
                 .unwrap();
             // Within the horizon the bound is the true gap, to the lower bounds' rounding.
             let want = expect.min(0.1);
             assert!(g <= want + 1e-6 && g >= want - 1e-3, "x {x}: gap {g}, want {want}");
         }
         let touching = Solid::obstacle(&Obstacle::sphere([0.46, 0.0, 0.5], 0.05).unwrap());
-        let c = Vector3::new(0.46, 0.0, 0.5);
-        let r = s.gap(&c, 0.05, 0.002, 0.1, |e| {
-            let d = distance_lower_bound(&touching, e);
-            (d > 0.002).then_some(d)
+        let r = s.gap(&around(0.46), 0.002, 0.1, |p| match p {
+            Probe::Piece(e) => {
+                let d = distance_lower_bound(&touching, e);
+                (d > 0.002).then_some(d)
+            }
+            Probe::Box(_) => None,
         });
         assert_eq!(r, Err(2));
     }

@@ -74,8 +74,9 @@ pub struct Surfaces {
 impl Surfaces {
     /// The view the core's scene borrows.
     pub fn surface(&self) -> Surface<'_> {
-        // Built by `bvh::build` over exactly these pieces: `Surface::new` accepts it.
-        Surface::new(&self.pieces, &self.nodes).unwrap_or(Surface::EMPTY)
+        // Built by `bvh::build` over exactly these pieces (`build_surfaces` checked it once with
+        // `Surface::new`), and private: no need to walk them again on every call.
+        Surface::from_built(&self.pieces, &self.nodes)
     }
 
     /// Pieces held (balls and non-degenerate triangles).
@@ -357,6 +358,7 @@ pub fn build_surfaces(
         pieces,
         nodes,
     };
+    Surface::new(&surfaces.pieces, &surfaces.nodes).map_err(|e| surface_error(e, "obstacles"))?;
     let mut boxes = [Obstacle::PLACEHOLDER; SURFACE_BOXES];
     let made = covers(&surfaces.surface(), &mut boxes);
     surfaces.boxes = boxes[..made].to_vec();
