@@ -26,7 +26,7 @@ impl Reader<'_> {
 }
 
 /// Up to `N` fuzzed obstacles (quaternions normalised when possible, so valid shapes are common).
-pub fn scene<const N: usize>(r: &mut Reader) -> Scene<N> {
+pub fn scene<const N: usize>(r: &mut Reader) -> Scene<'static, N> {
     let mut scene = Scene::<N>::new();
     let count = usize::from(r.byte()) % (N + 1);
     for _ in 0..count {

@@ -20,7 +20,7 @@ fuzz_target!(|data: &[u8]| {
                     assert!(position.iter().chain(quaternion.iter()).all(|v| v.is_finite()))
                 }
             }
-            assert!(problem.scene.obstacles().len() <= edmp_core::scene::MAX_OBSTACLES);
+            assert!(problem.scene().obstacles().len() <= edmp_core::scene::MAX_OBSTACLES);
         }
         Err(message) => assert!(!message.to_string().is_empty(), "an error names its field"),
     }
