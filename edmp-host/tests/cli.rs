@@ -303,6 +303,15 @@ fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
             with(r#"{"type": "points", "points": [[0, 0, 0.5]], "radius": 0.05}"#),
             "start: in collision: ",
         ),
+        // A closed 4 m cube around the whole arm: no body touches a triangle, all are inside.
+        (
+            "inside a closed mesh",
+            with(
+                r#"{"type": "mesh", "scale": 2, "vertices": [[-1,-1,-1],[1,-1,-1],[1,1,-1],[-1,1,-1],[-1,-1,1],[1,-1,1],[1,1,1],[-1,1,1]],
+                   "triangles": [[0,2,1],[0,3,2],[4,5,6],[4,6,7],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]]}"#,
+            ),
+            "start: in collision: panda_link1 inside the closed mesh obstacles[0]",
+        ),
     ];
     for (name, text, message) in surface_cases {
         cases.push((name, text, message));

@@ -4,7 +4,7 @@
 
 pub use super::fields::InputError;
 use super::fields::{field, number, numbers, object, quaternion};
-use super::surface::{Surfaces, build_surfaces, is_surface, read_obstacle};
+use super::surface::{Surfaces, build_surfaces, inside_closed_mesh, is_surface, read_obstacle};
 use edmp_core::collision::checker::{CheckConfig, Contact, check_end};
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
@@ -290,6 +290,12 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
     let surfaces = build_surfaces(surface_obstacles, &start, scene.gripper())?;
     let primitive_scene = scene;
     let scene = with_surfaces(&primitive_scene, &surfaces);
+    if let Some((body, i)) = inside_closed_mesh(&surfaces, &start, scene.gripper()) {
+        return Err(InputError::at(
+            &sp,
+            format!("in collision: {body} inside the closed mesh obstacles[{i}]"),
+        ));
+    }
     if let Some(c) =
         check_end(&scene, &start, &CheckConfig::default()).map_err(|e| InputError::at(&sp, e.to_string()))?
     {
@@ -304,6 +310,12 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
         (Some(q), None) => {
             let path = format!("{gp}.joints");
             let q = joints(q, &path)?;
+            if let Some((body, i)) = inside_closed_mesh(&surfaces, &q, scene.gripper()) {
+                return Err(InputError::at(
+                    &path,
+                    format!("in collision: {body} inside the closed mesh obstacles[{i}]"),
+                ));
+            }
             if let Some(c) =
                 check_end(&scene, &q, &CheckConfig::default()).map_err(|e| InputError::at(&path, e.to_string()))?
             {

@@ -364,3 +364,71 @@ pub fn build_surfaces(
     surfaces.boxes = boxes[..made].to_vec();
     Ok(surfaces)
 }
+
+/// Whether a mesh is closed: every edge is shared by exactly two of its (non-degenerate)
+/// triangles. A closed mesh's inside is part of the obstacle (docs/formats.md).
+pub fn is_closed(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
+    let mut edges: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for t in triangles {
+        let corner = |i: u32| vertices.get(i as usize).map(|v| Vector3::from(*v));
+        let (Some(a), Some(b), Some(c)) = (corner(t[0]), corner(t[1]), corner(t[2])) else {
+            return false;
+        };
+        if (b - a).cross(&(c - a)).norm_squared() <= 1e-20 {
+            continue;
+        }
+        for (i, j) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            *edges.entry((i.min(j), i.max(j))).or_default() += 1;
+        }
+    }
+    !edges.is_empty() && edges.values().all(|&n| n == 2)
+}
+
+/// Whether `p` lies inside a closed mesh: the parity of the mesh's triangles a ray from `p`
+/// crosses (a direction no axis-aligned face is parallel to).
+pub fn encloses(vertices: &[[f32; 3]], triangles: &[[u32; 3]], p: &Vector3<f32>) -> bool {
+    let d = Vector3::new(0.577_215_7, 0.301_029_9, 0.759_397_5).normalize();
+    let mut crossings = 0u32;
+    for t in triangles {
+        let corner = |i: u32| vertices.get(i as usize).map(|v| Vector3::from(*v));
+        let (Some(a), Some(b), Some(c)) = (corner(t[0]), corner(t[1]), corner(t[2])) else {
+            continue;
+        };
+        // Möller-Trumbore.
+        let (e1, e2) = (b - a, c - a);
+        let h = d.cross(&e2);
+        let det = e1.dot(&h);
+        if det.abs() < 1e-12 {
+            continue;
+        }
+        let s = p - a;
+        let u = s.dot(&h) / det;
+        let q = s.cross(&e1);
+        let v = d.dot(&q) / det;
+        let t = e2.dot(&q) / det;
+        if (0.0..=1.0).contains(&u) && v >= 0.0 && u + v <= 1.0 && t > 0.0 {
+            crossings += 1;
+        }
+    }
+    crossings % 2 == 1
+}
+
+/// The first robot body (by name) whose box centre lies inside a closed mesh at `q`, and that
+/// mesh's obstacle index: an end there touches no triangle yet is inside the obstacle.
+pub fn inside_closed_mesh(surfaces: &Surfaces, q: &Joints<f32>, finger: f32) -> Option<(&'static str, usize)> {
+    let k = edmp_core::robot::kinematics::forward_with(q, finger).ok()?;
+    for o in &surfaces.obstacles {
+        let SurfaceKind::Mesh { vertices, triangles } = &o.kind else {
+            continue;
+        };
+        if !is_closed(vertices, triangles) {
+            continue;
+        }
+        for (b, pose) in k.boxes.iter().enumerate() {
+            if edmp_core::robot::PANDA.bodies[b].frame != 0 && encloses(vertices, triangles, &pose.translation) {
+                return Some((edmp_core::robot::BODY_NAMES[b], o.index));
+            }
+        }
+    }
+    None
+}
