@@ -387,7 +387,7 @@ pub fn is_closed(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
 /// Whether `p` lies inside a closed mesh: the parity of the mesh's triangles a ray from `p`
 /// crosses (a direction no axis-aligned face is parallel to).
 pub fn encloses(vertices: &[[f32; 3]], triangles: &[[u32; 3]], p: &Vector3<f32>) -> bool {
-    let d = Vector3::new(0.577_215_7, 0.301_029_9, 0.759_397_5).normalize();
+    let d = Vector3::new(0.577_215_7, 0.313_717_4, 0.759_397_5).normalize();
     let mut crossings = 0u32;
     for t in triangles {
         let corner = |i: u32| vertices.get(i as usize).map(|v| Vector3::from(*v));
