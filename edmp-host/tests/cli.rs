@@ -330,8 +330,59 @@ fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
 }
 
 /// The scene of an `edmp-scene/1` document, rebuilt here from the JSON with the core's
-/// constructors (independent of the host's parser).
+/// constructors (independent of the host's parser). Clouds and meshes: inline vertices or an
+/// ASCII PLY beside the examples, in the world frame (no placement), no robot filter.
 fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene<'static> {
+    use edmp_core::surface::bvh::{Node, build, nodes_for};
+    use edmp_core::surface::element::Element;
+    let v3 = |v: &serde_json::Value| -> [f32; 3] { core::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
+    let mut pieces = Vec::new();
+    for (i, o) in doc["obstacles"].as_array().unwrap().iter().enumerate() {
+        match o["type"].as_str().unwrap() {
+            "points" => {
+                let ply = std::fs::read_to_string(
+                    std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples"))
+                        .join(o["file"].as_str().unwrap()),
+                )
+                .unwrap();
+                let body = ply.split("end_header\n").nth(1).unwrap();
+                let r = o["radius"].as_f64().unwrap() as f32;
+                for line in body.lines() {
+                    let p: Vec<f32> = line.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                    pieces.push(Element::ball([p[0], p[1], p[2]], r, i as u16).unwrap());
+                }
+            }
+            "mesh" => {
+                let v: Vec<[f32; 3]> = o["vertices"].as_array().unwrap().iter().map(v3).collect();
+                for t in o["triangles"].as_array().unwrap() {
+                    let k = |j: usize| v[t[j].as_u64().unwrap() as usize];
+                    pieces.extend(Element::triangle([k(0), k(1), k(2)], i as u16).unwrap());
+                }
+            }
+            _ => {}
+        }
+    }
+    let scene = primitive_scene_of(doc);
+    if pieces.is_empty() {
+        return scene;
+    }
+    let zero = Node {
+        lo: [0.0; 3],
+        hi: [0.0; 3],
+        first: 0,
+        count: 0,
+        left: 0,
+    };
+    let mut nodes = vec![zero; nodes_for(pieces.len())];
+    let used = build(&mut pieces, &mut nodes).unwrap();
+    nodes.truncate(used);
+    let (pieces, nodes): (&'static [Element], &'static [Node]) = (pieces.leak(), nodes.leak());
+    let surface = edmp_core::surface::Surface::new(pieces, nodes).unwrap();
+    scene.with_surface(surface, &[])
+}
+
+/// The primitives, held object and opening of an `edmp-scene/1` document.
+fn primitive_scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene<'static> {
     use edmp_core::scene::{Obstacle, Scene};
     let v3 = |v: &serde_json::Value| -> [f32; 3] { core::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
     let v4 = |v: &serde_json::Value| -> [f32; 4] { core::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
@@ -352,7 +403,9 @@ fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene<'static> {
     };
     let mut scene = Scene::new();
     for o in doc["obstacles"].as_array().unwrap() {
-        scene.push(primitive(o)).unwrap();
+        if !matches!(o["type"].as_str(), Some("points" | "mesh")) {
+            scene.push(primitive(o)).unwrap();
+        }
     }
     if let Some(held) = doc.get("held_object") {
         scene.hold(primitive(held));

@@ -5,11 +5,14 @@
 //! `tabletop-000`) and `DIR/expected.txt`, one line `<name> <status> <fingerprint>` per scene in
 //! the order given. The host plans the scene it rebuilt from the wire bytes, with the firmware's
 //! settings: [`PlanConfig::DEFAULT`], EDMP's 12 guides, 12 rows, `Rng::new(seed)`.
+//! A scene with `points` or `mesh` obstacles travels with its pieces and tree as the host built
+//! them (`edmp_core::wire`), at most [`FIRMWARE_PIECES`] of them.
 //! `DIR/expected-timed.txt` has `<name> <fingerprint|none>`: the chosen path's time
 //! parameterization (Franka's limits, jerk-limited) for free plans, as the firmware times it.
 
 use crate::Failure;
-use crate::formats::json::{joint_goal, parse_problem};
+use crate::formats::json::{self, joint_goal, parse_problem, read_problem};
+use crate::formats::surface::SURFACE_BOXES;
 use core::fmt::Write as _;
 use edmp_core::guidance::guides::EDMP_GUIDES;
 use edmp_core::planner::{Plan, PlanConfig, Request, Workspace, plan};
@@ -17,7 +20,7 @@ use edmp_core::prior::Scratch;
 use edmp_core::rng::Rng;
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
-use edmp_core::wire::Problem;
+use edmp_core::wire::{Problem, WireSurface, decode, encode_surface, surface_bytes_max};
 use std::path::{Path, PathBuf};
 
 /// Rows of the firmware's batch: one per EDMP guide.
@@ -50,11 +53,42 @@ fn scene_name(path: &Path) -> Result<String, String> {
     }
 }
 
-/// The same conversion as `json::parse_problem`: f64 → f32, rounding to nearest.
-/// The wire problem of a scene file: validated by `parse_problem`, goal resolved to joints.
+/// Pieces (balls and triangles of every cloud and mesh together) the firmware decodes into its
+/// `WireSurface` (examples/firmware-qemu/src/main.rs, `PIECES`): the host refuses more.
+pub const FIRMWARE_PIECES: usize = 1024;
+
+/// The firmware scene's obstacle capacity (examples/firmware-qemu/src/main.rs, `OBSTACLES`):
+/// primitives and guide boxes of a scene with clouds or meshes must fit it, or the firmware's
+/// guides would see fewer boxes than the host's.
+pub const FIRMWARE_OBSTACLES: usize = 40;
+
+/// A scene as the firmware receives it.
+#[derive(Clone, Debug)]
+pub struct Embedded {
+    /// The primitives, ends, finger opening and seed.
+    pub problem: Problem<MAX_OBSTACLES>,
+    /// The postcard bytes: the problem's, then the surface section when the scene has clouds
+    /// or meshes (`edmp_core::wire::decode`).
+    pub bytes: Vec<u8>,
+}
+
+/// The decoded surface: the firmware's capacity.
+type Decoded = WireSurface<FIRMWARE_PIECES>;
+
+/// The wire problem of a scene file without clouds or meshes (those need [`embed_problem`]):
+/// validated by `parse_problem`, goal resolved to joints.
 pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, String> {
     let parsed = parse_problem(text).map_err(|e| e.to_string())?;
-    let goal = joint_goal(&parsed)?;
+    if parsed.surfaces.pieces() > 0 {
+        return Err("the scene has clouds or meshes: embed_problem carries them".to_owned());
+    }
+    Ok(embed_problem(&parsed, seed)?.problem)
+}
+
+/// The firmware's bytes of a parsed scene (its clouds and meshes built by `parse_problem`, the
+/// pieces and the tree travelling as built), checked to decode to the host's scene exactly.
+pub fn embed_problem(parsed: &json::Problem, seed: u64) -> Result<Embedded, String> {
+    let goal = joint_goal(parsed)?;
     let mut problem = Problem {
         obstacles: Default::default(),
         held: parsed.held,
@@ -69,20 +103,55 @@ pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, Str
             .push(*p)
             .map_err(|_| format!("more than {MAX_OBSTACLES} obstacles"))?;
     }
-    // The firmware rebuilds the scene from these numbers: it must be the host's scene exactly.
-    let rebuilt = problem.to_scene().map_err(|e| e.to_string())?;
-    if rebuilt.obstacles() != parsed.scene().obstacles()
-        || rebuilt.held() != parsed.scene().held()
-        || rebuilt.gripper() != parsed.scene().gripper()
+    let mut bytes = postcard::to_stdvec(&problem).map_err(|e| e.to_string())?;
+    let surface = parsed.surfaces.surface();
+    if !surface.is_empty() {
+        let pieces = surface.pieces().len();
+        if pieces > FIRMWARE_PIECES {
+            return Err(format!(
+                "{pieces} balls and triangles (clouds and meshes together), the firmware holds at most \
+                 {FIRMWARE_PIECES}: fewer points or a coarser mesh"
+            ));
+        }
+        let guides = problem.obstacles.len() + parsed.surfaces.boxes.len();
+        if guides > FIRMWARE_OBSTACLES {
+            return Err(format!(
+                "{} primitives and {} boxes around the clouds and meshes, the firmware's scene holds \
+                 at most {FIRMWARE_OBSTACLES}",
+                problem.obstacles.len(),
+                parsed.surfaces.boxes.len()
+            ));
+        }
+        let mut section = vec![0u8; surface_bytes_max(pieces, surface.nodes().len())];
+        // The limit the host's `build_surfaces` gave `covers`: the firmware fits the same boxes.
+        let boxes = u8::try_from(SURFACE_BOXES).map_err(|e| e.to_string())?;
+        let n = encode_surface(surface.pieces(), surface.nodes(), boxes, &mut section).map_err(|e| e.to_string())?;
+        bytes.extend_from_slice(&section[..n]);
+    }
+    // The firmware rebuilds the scene from these bytes: it must be the host's scene exactly.
+    let mut decoded = Box::new(Decoded::new());
+    let back = decode::<MAX_OBSTACLES, FIRMWARE_PIECES>(&bytes, &mut decoded).map_err(|e| e.to_string())?;
+    let rebuilt = back.to_scene_with(&decoded).map_err(|e| e.to_string())?;
+    let scene = parsed.scene();
+    if back != problem
+        || rebuilt.obstacles() != scene.obstacles()
+        || rebuilt.guide_obstacles() != scene.guide_obstacles()
+        || rebuilt.surface().pieces() != scene.surface().pieces()
+        || rebuilt.surface().nodes() != scene.surface().nodes()
+        || rebuilt.held() != scene.held()
+        || rebuilt.gripper() != scene.gripper()
     {
         return Err("the wire scene differs from the parsed one".to_owned());
     }
-    Ok(problem)
+    Ok(Embedded { problem, bytes })
 }
 
-/// The firmware's plan, on the host: same configuration, guides, rows and seed.
-pub fn plan_like_firmware(problem: &Problem<MAX_OBSTACLES>) -> Result<Plan<ROWS>, String> {
-    let scene: Scene<MAX_OBSTACLES> = problem.to_scene().map_err(|e| e.to_string())?;
+/// The firmware's plan of `bytes`, on the host: the scene decoded from them, same
+/// configuration, guides, rows and seed.
+pub fn plan_like_firmware(bytes: &[u8]) -> Result<Plan<ROWS>, String> {
+    let mut decoded = Box::new(Decoded::new());
+    let problem = decode::<MAX_OBSTACLES, FIRMWARE_PIECES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
+    let scene: Scene<MAX_OBSTACLES> = problem.to_scene_with(&decoded).map_err(|e| e.to_string())?;
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<ROWS>::new());
     let mut rng = Rng::new(problem.seed);
@@ -110,17 +179,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     for path in &args.scenes {
         let at = |e: String| Failure::Input(format!("{}: {e}", path.display()));
         let name = scene_name(path).map_err(input)?;
-        let text = std::fs::read_to_string(path).map_err(|e| at(e.to_string()))?;
-        let problem = wire_problem(&text, args.seed).map_err(at)?;
-        let bytes = postcard::to_stdvec(&problem).map_err(|e| at(e.to_string()))?;
+        // Files a scene names (clouds, meshes) lie beside it.
+        let parsed = read_problem(path).map_err(input)?;
+        let Embedded { bytes, .. } = embed_problem(&parsed, args.seed).map_err(at)?;
         let file = args.out.join(format!("{name}.postcard"));
         std::fs::write(&file, &bytes).map_err(|e| input(format!("{}: {e}", file.display())))?;
-        let plan = plan_like_firmware(&problem).map_err(at)?;
+        let plan = plan_like_firmware(&bytes).map_err(at)?;
         let status = if plan.is_free() { "success" } else { "collision" };
         let line = format!("{name} {status} {:016x}", plan.fingerprint());
         println!("{line}  ({} bytes)", bytes.len());
         let _ = writeln!(expected, "{line}");
-        let timed = time_like_firmware(&problem, &plan).map_err(at)?;
+        let timed = time_like_firmware(&bytes, &plan).map_err(at)?;
         let _ = writeln!(
             expected_timed,
             "{name} {}",
@@ -136,11 +205,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 
 /// The firmware's time parameterization of a free plan's chosen path, on the host: its
 /// fingerprint, `None` for a colliding plan (the firmware times only free ones).
-pub fn time_like_firmware(problem: &Problem<MAX_OBSTACLES>, plan: &Plan<ROWS>) -> Result<Option<u64>, String> {
+pub fn time_like_firmware(bytes: &[u8], plan: &Plan<ROWS>) -> Result<Option<u64>, String> {
     let Some(path) = plan.paths.get(plan.best).filter(|_| plan.is_free()) else {
         return Ok(None);
     };
-    let scene: Scene<MAX_OBSTACLES> = problem.to_scene().map_err(|e| e.to_string())?;
+    let mut decoded = Box::new(Decoded::new());
+    let problem = decode::<MAX_OBSTACLES, FIRMWARE_PIECES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
+    let scene: Scene<MAX_OBSTACLES> = problem.to_scene_with(&decoded).map_err(|e| e.to_string())?;
     let mut timed: Box<Timed> = Box::new(Timed::new());
     parameterize_checked(&scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, &mut timed)
         .map_err(|e| format!("time parameterization: {e}"))?;
@@ -160,6 +231,48 @@ mod tests {
         let back: Problem<MAX_OBSTACLES> = postcard::from_bytes(&bytes).unwrap();
         assert_eq!(back, problem);
         assert_eq!(back.seed, 3);
+    }
+
+    #[test]
+    fn clouds_and_meshes_travel_built_and_decode_to_the_hosts_scene() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+        for (file, pieces) in [("wall-points.json", 972), ("wall-mesh.json", 12)] {
+            let parsed = read_problem(&root.join(file)).unwrap();
+            let e = embed_problem(&parsed, 0).unwrap();
+            assert_eq!(e.problem.obstacles.len(), 3, "{file}");
+            let mut decoded = Box::new(Decoded::new());
+            let back = decode::<MAX_OBSTACLES, FIRMWARE_PIECES>(&e.bytes, &mut decoded).unwrap();
+            assert_eq!(back, e.problem);
+            assert_eq!(decoded.pieces().len(), pieces, "{file}");
+            let scene = back.to_scene_with(&decoded).unwrap();
+            assert_eq!(scene.guide_obstacles(), parsed.scene().guide_obstacles(), "{file}");
+            assert!(scene.guide_obstacles().len() > 3, "{file}: guide boxes");
+            // Without the section the bytes are a problem without a surface.
+            let plain = postcard::to_stdvec(&e.problem).unwrap();
+            assert!(e.bytes.len() > plain.len() && e.bytes.starts_with(&plain));
+            assert!(wire_problem(&std::fs::read_to_string(root.join("wall-mesh.json")).unwrap(), 0).is_err());
+        }
+    }
+
+    #[test]
+    fn a_cloud_beyond_the_firmwares_capacity_is_refused() {
+        let points: Vec<String> = (0..FIRMWARE_PIECES + 1)
+            .map(|i| {
+                format!(
+                    "[-0.7, {}, {}]",
+                    (i % 40) as f32 * 0.01 - 0.2,
+                    0.3 + (i / 40) as f32 * 0.01
+                )
+            })
+            .collect();
+        let text = format!(
+            r#"{{"format": "edmp-scene/1", "obstacles": [{{"type": "points", "radius": 0.004, "points": [{}]}}],
+                "start": [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785], "goal": {{"joints": [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785]}}}}"#,
+            points.join(", ")
+        );
+        let parsed = parse_problem(&text).unwrap();
+        let e = embed_problem(&parsed, 0).unwrap_err();
+        assert!(e.contains("the firmware holds at most 1024"), "{e}");
     }
 
     #[test]

@@ -1,7 +1,9 @@
 //! edmp-core's planner as Cortex-M4F firmware, run under QEMU (`mps2-an386`).
 //!
-//! Plans each embedded scene (postcard bytes from `edmp-host embed`) with the shipped
-//! configuration, EDMP's 12 guides and 12 rows, and prints one line per scene over semihosting:
+//! Plans each embedded scene (postcard bytes from `edmp-host embed`; a scene with a point cloud or
+//! a mesh carries its pieces and their tree, decoded into a `static` and validated) with the
+//! shipped configuration, EDMP's 12 guides and 12 rows, and prints one line per scene over
+//! semihosting:
 //!
 //! ```text
 //! plan <name> <success|collision> <fingerprint> instructions <n> stack <bytes>
@@ -33,7 +35,7 @@ use edmp_core::rng::Rng;
 use edmp_core::robot::JOINTS;
 use edmp_core::scene::{Scene, SceneError};
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
-use edmp_core::wire::Problem;
+use edmp_core::wire::{Problem, WireError, WireSurface, decode as decode_wire};
 
 #[cfg(feature = "panic-report")]
 use panic_semihosting as _;
@@ -59,6 +61,10 @@ const ROWS: usize = 12;
 /// (about 410 bytes of stack each, measured).
 const OBSTACLES: usize = 40;
 
+/// Pieces of a scene's clouds and meshes (balls and triangles together; as many tree nodes):
+/// `edmp-host embed` refuses more (its `FIRMWARE_PIECES`). About 72 bytes each, in `.bss`.
+const PIECES: usize = 1024;
+
 /// The embedded scenes, in `edmp-host embed`'s order (scripts/firmware lists the same files).
 const SCENES: &[(&str, &[u8])] = &[
     ("examples-wall", include_bytes!("../scenes/examples-wall.postcard")),
@@ -70,6 +76,9 @@ const SCENES: &[(&str, &[u8])] = &[
     ("dresser-000", include_bytes!("../scenes/dresser-000.postcard")),
     // An unseen kind whose first stage collides: the global stage (search, reseeding) runs.
     ("window_box-003", include_bytes!("../scenes/window_box-003.postcard")),
+    // The wall's vertical box as a cloud of 972 points, then as a mesh of 12 triangles.
+    ("examples-wall-points", include_bytes!("../scenes/examples-wall-points.postcard")),
+    ("examples-wall-mesh", include_bytes!("../scenes/examples-wall-mesh.postcard")),
 ];
 
 /// The network's working memory for one trajectory at a time (`.bss`, not the stack).
@@ -78,6 +87,8 @@ static mut SCRATCH: Scratch<1> = Scratch::new();
 static mut WORK: Workspace<ROWS> = Workspace::new();
 /// The chosen path's time parameterization (`.bss`).
 static mut TIMED: Timed = Timed::new();
+/// The decoded pieces and tree of the scene's clouds and meshes (`.bss`).
+static mut SURFACE: WireSurface<PIECES> = WireSurface::new();
 
 /// SysTick wraps (every 2^24 ticks), counted by its exception.
 static WRAPS: AtomicU32 = AtomicU32::new(0);
@@ -232,18 +243,28 @@ fn scene_error_name(e: SceneError) -> &'static str {
     }
 }
 
+fn wire_error_name(e: WireError) -> &'static str {
+    match e {
+        WireError::Decode => "bad postcard bytes (or more than OBSTACLES obstacles)",
+        WireError::Capacity => "more pieces or nodes than PIECES",
+        WireError::TooManyBoxes => "too many guide boxes",
+        WireError::DegenerateTriangle => "surface: degenerate triangle",
+        WireError::Surface(_) => "surface: a piece or the tree refused",
+        WireError::Scene(e) => scene_error_name(e),
+        _ => "wire error",
+    }
+}
+
 /// Why a scene was not planned.
 enum Failure {
-    Decode,
-    Scene(SceneError),
+    Wire(WireError),
     Plan(Error),
 }
 
 impl Failure {
     fn name(&self) -> &'static str {
         match self {
-            Self::Decode => "bad postcard bytes (or more than OBSTACLES obstacles)",
-            Self::Scene(e) => scene_error_name(*e),
+            Self::Wire(e) => wire_error_name(*e),
             Self::Plan(e) => error_name(*e),
         }
     }
@@ -256,17 +277,27 @@ struct Summary {
     path: Path,
 }
 
-fn decode(bytes: &[u8]) -> Result<(Problem<OBSTACLES>, Scene<OBSTACLES>), Failure> {
-    let problem: Problem<OBSTACLES> = postcard::from_bytes(bytes).map_err(|_| Failure::Decode)?;
-    let scene = problem.to_scene().map_err(Failure::Scene)?;
+/// The problem and its scene, the scene's surface decoded into `surface`.
+fn decode<'a>(
+    bytes: &[u8],
+    surface: &'a mut WireSurface<PIECES>,
+) -> Result<(Problem<OBSTACLES>, Scene<'a, OBSTACLES>), Failure> {
+    let problem: Problem<OBSTACLES> = decode_wire(bytes, surface).map_err(Failure::Wire)?;
+    let surface: &'a WireSurface<PIECES> = surface;
+    let scene = problem.to_scene_with(surface).map_err(Failure::Wire)?;
     Ok((problem, scene))
 }
 
 /// Decodes and plans one scene. Not inlined, and the plan stays in this frame: the stack
 /// high-water mark is the planner's, plus `main`'s small frame.
 #[inline(never)]
-fn plan_scene(bytes: &[u8], scratch: &mut Scratch<1>, work: &mut Workspace<ROWS>) -> Result<Summary, Failure> {
-    let (problem, scene) = decode(bytes)?;
+fn plan_scene(
+    bytes: &[u8],
+    scratch: &mut Scratch<1>,
+    work: &mut Workspace<ROWS>,
+    surface: &mut WireSurface<PIECES>,
+) -> Result<Summary, Failure> {
+    let (problem, scene) = decode(bytes, surface)?;
     let mut rng = Rng::new(problem.seed);
     let plan: Plan<ROWS> = plan::<ROWS, OBSTACLES, 1, { edmp_core::planner::DEFAULT_SEARCH_NODES }>(&Request { scene: &scene, start: &problem.start, goal: &problem.goal, guides: &EDMP_GUIDES, config: &PlanConfig::DEFAULT }, &mut rng, scratch, work)
     .map_err(Failure::Plan)?;
@@ -281,8 +312,8 @@ fn plan_scene(bytes: &[u8], scratch: &mut Scratch<1>, work: &mut Workspace<ROWS>
 /// Times a free plan's path as the host's `--timed` does: the spline checked against the scene
 /// (else the polyline), Franka's limits, jerk-limited.
 #[inline(never)]
-fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed) -> Result<u64, Failure> {
-    let (_, scene) = decode(bytes)?;
+fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed, surface: &mut WireSurface<PIECES>) -> Result<u64, Failure> {
+    let (_, scene) = decode(bytes, surface)?;
     parameterize_checked(&scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, timed).map_err(Failure::Plan)?;
     Ok(timed.fingerprint())
 }
@@ -290,8 +321,8 @@ fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed) -> Result<u64, Failur
 /// Ticks of one network evaluation of all 12 rows (noise between the scene's ends, step 255),
 /// to split a plan's instructions into network and the rest.
 #[inline(never)]
-fn time_network(bytes: &[u8], scratch: &mut Scratch<1>) -> Result<u64, Failure> {
-    let (problem, _) = decode(bytes)?;
+fn time_network(bytes: &[u8], scratch: &mut Scratch<1>, surface: &mut WireSurface<PIECES>) -> Result<u64, Failure> {
+    let (problem, _) = decode(bytes, surface)?;
     let mut rng = Rng::new(problem.seed);
     let mut paths = [[[0.0f32; JOINTS]; HORIZON]; ROWS];
     let mut eps = paths;
@@ -320,9 +351,15 @@ fn main() -> ! {
     while SYST::get_current() == 0 {}
 
     // SAFETY: `main` never returns and takes these references once; nothing else (no
-    // interrupt handler) touches SCRATCH, WORK or TIMED.
-    let (scratch, work, timed) =
-        unsafe { (&mut *addr_of_mut!(SCRATCH), &mut *addr_of_mut!(WORK), &mut *addr_of_mut!(TIMED)) };
+    // interrupt handler) touches SCRATCH, WORK, TIMED or SURFACE.
+    let (scratch, work, timed, surface) = unsafe {
+        (
+            &mut *addr_of_mut!(SCRATCH),
+            &mut *addr_of_mut!(WORK),
+            &mut *addr_of_mut!(TIMED),
+            &mut *addr_of_mut!(SURFACE),
+        )
+    };
 
     let per_tick = instructions_per_tick();
     out.str("systick instructions-per-tick ").dec(per_tick).str("\n");
@@ -332,7 +369,7 @@ fn main() -> ! {
     for &(name, bytes) in SCENES {
         paint_stack();
         let began = ticks();
-        let result = plan_scene(bytes, scratch, work);
+        let result = plan_scene(bytes, scratch, work, surface);
         let spent = (ticks() - began) * per_tick;
         let stack = stack_high_water();
         peak_stack = peak_stack.max(stack);
@@ -352,7 +389,7 @@ fn main() -> ! {
                 }
                 paint_stack();
                 let began = ticks();
-                let result = time_path(bytes, &plan.path, timed);
+                let result = time_path(bytes, &plan.path, timed, surface);
                 let spent = (ticks() - began) * per_tick;
                 peak_stack = peak_stack.max(stack_high_water());
                 match result {
@@ -373,7 +410,7 @@ fn main() -> ! {
     }
     if let Some(&(name, bytes)) = SCENES.first() {
         paint_stack();
-        match time_network(bytes, scratch) {
+        match time_network(bytes, scratch, surface) {
             Ok(t) => {
                 let evaluations = PlanConfig::DEFAULT.sampler.evaluations() as u64;
                 out.strs(&["network ", name, " instructions-per-evaluation "])
