@@ -55,7 +55,7 @@ fn scene_name(path: &Path) -> Result<String, String> {
 
 /// Pieces (balls and triangles of every cloud and mesh together) the firmware decodes into its
 /// `WireSurface` (examples/firmware-qemu/src/main.rs, `PIECES`): the host refuses more.
-pub const FIRMWARE_PIECES: usize = 1024;
+pub const FIRMWARE_PIECES: usize = 320;
 
 /// The firmware scene's obstacle capacity (examples/firmware-qemu/src/main.rs, `OBSTACLES`):
 /// primitives and guide boxes of a scene with clouds or meshes must fit it, or the firmware's
@@ -236,7 +236,7 @@ mod tests {
     #[test]
     fn clouds_and_meshes_travel_built_and_decode_to_the_hosts_scene() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
-        for (file, pieces) in [("wall-points.json", 972), ("wall-mesh.json", 12)] {
+        for (file, pieces) in [("wall-points.json", 280), ("wall-mesh.json", 12)] {
             let parsed = read_problem(&root.join(file)).unwrap();
             let e = embed_problem(&parsed, 0).unwrap();
             assert_eq!(e.problem.obstacles.len(), 3, "{file}");
@@ -272,7 +272,7 @@ mod tests {
         );
         let parsed = parse_problem(&text).unwrap();
         let e = embed_problem(&parsed, 0).unwrap_err();
-        assert!(e.contains("the firmware holds at most 1024"), "{e}");
+        assert!(e.contains("the firmware holds at most 320"), "{e}");
     }
 
     #[test]

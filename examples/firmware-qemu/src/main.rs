@@ -63,7 +63,7 @@ const OBSTACLES: usize = 40;
 
 /// Pieces of a scene's clouds and meshes (balls and triangles together; as many tree nodes):
 /// `edmp-host embed` refuses more (its `FIRMWARE_PIECES`). About 72 bytes each, in `.bss`.
-const PIECES: usize = 1024;
+const PIECES: usize = 320;
 
 /// The embedded scenes, in `edmp-host embed`'s order (scripts/firmware lists the same files).
 const SCENES: &[(&str, &[u8])] = &[
@@ -76,7 +76,7 @@ const SCENES: &[(&str, &[u8])] = &[
     ("dresser-000", include_bytes!("../scenes/dresser-000.postcard")),
     // An unseen kind whose first stage collides: the global stage (search, reseeding) runs.
     ("window_box-003", include_bytes!("../scenes/window_box-003.postcard")),
-    // The wall's vertical box as a cloud of 972 points, then as a mesh of 12 triangles.
+    // The wall's vertical box as a cloud of 280 points, then as a mesh of 12 triangles.
     ("examples-wall-points", include_bytes!("../scenes/examples-wall-points.postcard")),
     ("examples-wall-mesh", include_bytes!("../scenes/examples-wall-mesh.postcard")),
 ];
