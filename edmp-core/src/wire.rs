@@ -398,14 +398,7 @@ mod tests {
                 .unwrap()
             })
             .collect();
-        let zero = Node {
-            lo: [0.0; 3],
-            hi: [0.0; 3],
-            first: 0,
-            count: 0,
-            left: 0,
-        };
-        let mut nodes = std::vec![zero; nodes_for(n)];
+        let mut nodes = std::vec![Node::EMPTY; nodes_for(n)];
         let used = build(&mut pieces, &mut nodes).unwrap();
         nodes.truncate(used);
         (pieces, nodes)

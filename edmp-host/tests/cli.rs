@@ -366,14 +366,7 @@ fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene<'static> {
     if pieces.is_empty() {
         return scene;
     }
-    let zero = Node {
-        lo: [0.0; 3],
-        hi: [0.0; 3],
-        first: 0,
-        count: 0,
-        left: 0,
-    };
-    let mut nodes = vec![zero; nodes_for(pieces.len())];
+    let mut nodes = vec![Node::EMPTY; nodes_for(pieces.len())];
     let used = build(&mut pieces, &mut nodes).unwrap();
     nodes.truncate(used);
     let (pieces, nodes): (&'static [Element], &'static [Node]) = (pieces.leak(), nodes.leak());

@@ -263,15 +263,23 @@ fn changed_near(a: &[u8], b: &[u8], centre: [f64; 2], radius: usize) -> usize {
     n
 }
 
+/// Whether Chromium is there to run the page; under CI it must be (`scripts/test` installs it).
+fn chromium_present() -> bool {
+    if Path::new(CHROMIUM).exists() {
+        return true;
+    }
+    assert_ne!(
+        std::env::var("CI").as_deref(),
+        Ok("true"),
+        "{CHROMIUM} is missing under CI: scripts/test installs it (apt-get install chromium)"
+    );
+    println!("note: {CHROMIUM} not found, the browser check is skipped (apt-get install chromium)");
+    false
+}
+
 #[test]
 fn chromium_draws_the_arm_where_the_kinematics_put_it() {
-    if !Path::new(CHROMIUM).exists() {
-        assert_ne!(
-            std::env::var("CI").as_deref(),
-            Ok("true"),
-            "{CHROMIUM} is missing under CI: scripts/test installs it (apt-get install chromium)"
-        );
-        println!("note: {CHROMIUM} not found, the browser check is skipped (apt-get install chromium)");
+    if !chromium_present() {
         return;
     }
     let dir = scratch("chromium");
@@ -344,13 +352,7 @@ fn chromium_draws_the_arm_where_the_kinematics_put_it() {
 
 #[test]
 fn chromium_draws_the_clouds_and_meshes() {
-    if !Path::new(CHROMIUM).exists() {
-        assert_ne!(
-            std::env::var("CI").as_deref(),
-            Ok("true"),
-            "{CHROMIUM} is missing under CI: scripts/test installs it (apt-get install chromium)"
-        );
-        println!("note: {CHROMIUM} not found, the browser check is skipped (apt-get install chromium)");
+    if !chromium_present() {
         return;
     }
     let dir = scratch("surfaces");
