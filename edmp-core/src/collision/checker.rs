@@ -3,9 +3,9 @@
 //! Geometry is exact, never boxed: each robot body is the convex hull of its collision mesh
 //! (the same hull PyBullet collides), obstacles and the held object are true cuboids,
 //! cylinders and spheres, and the balls and triangles of clouds and meshes
-//! ([`crate::surface`]), found near a body through their hierarchy. A pair is declared free only when a GJK separating direction
-//! *certifies* a gap larger than the margin ([`crate::collision::gjk::apart`]); anything else counts as
-//! contact. Cheap tests run first and can only prove freedom: bounding balls, then the body's
+//! ([`crate::surface`]), found near a body through their hierarchy. A pair is declared free
+//! only when a GJK separating direction *certifies* a gap larger than the margin
+//! ([`crate::collision::gjk::apart`]); anything else counts as contact. Cheap tests run first and can only prove freedom: bounding balls, then the body's
 //! oriented box (which holds its hull).
 //!
 //! Checked, as docs/formats.md defines a solved problem: every moving body (links 1-7, hand,
@@ -297,8 +297,9 @@ fn relative_motion(a: &[f32; JOINTS], b: &[f32; JOINTS], step: &Joints<f32>) -> 
     m
 }
 
-/// How far the surface's pieces are looked for around a body: nearer pieces are each proven
-/// clear, and the nearest one's gap (at most this) is carried to the next states.
+/// How far the surface's pieces are looked for around a body: nearer pieces are proven clear
+/// (a small subtree at once, or one by one), and the smallest gap found (at most this) is
+/// carried to the next states.
 const SURFACE_HORIZON: f32 = 0.05;
 
 /// What a certified gap leaves for the states after it, below the gap less the margin: room for
