@@ -5,8 +5,9 @@
 //! cylinders and spheres, and the balls and triangles of clouds and meshes
 //! ([`crate::surface`]), found near a body through their hierarchy. A pair is declared free
 //! only when a GJK separating direction *certifies* a gap larger than the margin
-//! ([`crate::collision::gjk::apart`]); anything else counts as contact. Cheap tests run first and can only prove freedom: bounding balls, then the body's
-//! oriented box (which holds its hull).
+//! ([`crate::collision::gjk::apart`]); anything else counts as contact. Cheap tests run
+//! first and can only prove freedom: bounding balls, then the body's oriented box (which holds
+//! its hull).
 //!
 //! Checked, as docs/formats.md defines a solved problem: every moving body (links 1-7, hand,
 //! fingers, held object) against every obstacle, and every pair of bodies that are not chain
