@@ -81,19 +81,10 @@ pub fn parse_obj(bytes: &[u8]) -> Result<TriangleMesh, FileError> {
         let mut words = tokens(line);
         match words.next() {
             Some(b"v") => {
-                let mut point = [0.0f32; 3];
-                for slot in &mut point {
-                    let Some(word) = words.next() else {
-                        return err("a vertex needs x y z".into());
-                    };
-                    let Some(v) = number(word) else {
-                        return err(format!("expected a number, found \"{}\"", show(word)));
-                    };
-                    *slot = match coordinate(v) {
-                        Ok(c) => c,
-                        Err(m) => return err(m),
-                    };
-                }
+                let point = match xyz(&mut words) {
+                    Ok(p) => p,
+                    Err(m) => return err(m),
+                };
                 if mesh.vertices.len() == u32::MAX as usize {
                     return err("more vertices than a u32 index reaches".into());
                 }
@@ -218,19 +209,10 @@ fn ascii_stl(bytes: &[u8]) -> Result<TriangleMesh, FileError> {
             (b"facet", true, false) => facet = Some(Vec::with_capacity(3)),
             (b"outer" | b"endloop", true, true) => {}
             (b"vertex", true, true) => {
-                let mut point = [0.0f32; 3];
-                for slot in &mut point {
-                    let Some(word) = words.next() else {
-                        return err("a vertex needs x y z".into());
-                    };
-                    let Some(v) = number(word) else {
-                        return err(format!("expected a number, found \"{}\"", show(word)));
-                    };
-                    *slot = match coordinate(v) {
-                        Ok(c) => c,
-                        Err(m) => return err(m),
-                    };
-                }
+                let point = match xyz(&mut words) {
+                    Ok(p) => p,
+                    Err(m) => return err(m),
+                };
                 if let Some(corners) = &mut facet {
                     if corners.len() == 3 {
                         return err("a facet with more than 3 vertices".into());
@@ -432,4 +414,15 @@ mod tests {
         assert!(message(read_mesh(&dir.join("gone.stl"))).contains("gone.stl: cannot read: "));
         std::fs::remove_dir_all(&dir).unwrap();
     }
+}
+
+/// The three coordinates `x y z` of a vertex line, each a finite `f32`.
+fn xyz<'a>(words: &mut impl Iterator<Item = &'a [u8]>) -> Result<[f32; 3], String> {
+    let mut point = [0.0f32; 3];
+    for slot in &mut point {
+        let word = words.next().ok_or("a vertex needs x y z")?;
+        let v = number(word).ok_or_else(|| format!("expected a number, found \"{}\"", show(word)))?;
+        *slot = coordinate(v)?;
+    }
+    Ok(point)
 }
