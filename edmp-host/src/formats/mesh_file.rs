@@ -244,6 +244,17 @@ fn ascii_stl(bytes: &[u8]) -> Result<TriangleMesh, FileError> {
     Ok(mesh)
 }
 
+/// The three coordinates `x y z` of a vertex line, each a finite `f32`.
+fn xyz<'a>(words: &mut impl Iterator<Item = &'a [u8]>) -> Result<[f32; 3], String> {
+    let mut point = [0.0f32; 3];
+    for slot in &mut point {
+        let word = words.next().ok_or("a vertex needs x y z")?;
+        let v = number(word).ok_or_else(|| format!("expected a number, found \"{}\"", show(word)))?;
+        *slot = coordinate(v)?;
+    }
+    Ok(point)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -414,15 +425,4 @@ mod tests {
         assert!(message(read_mesh(&dir.join("gone.stl"))).contains("gone.stl: cannot read: "));
         std::fs::remove_dir_all(&dir).unwrap();
     }
-}
-
-/// The three coordinates `x y z` of a vertex line, each a finite `f32`.
-fn xyz<'a>(words: &mut impl Iterator<Item = &'a [u8]>) -> Result<[f32; 3], String> {
-    let mut point = [0.0f32; 3];
-    for slot in &mut point {
-        let word = words.next().ok_or("a vertex needs x y z")?;
-        let v = number(word).ok_or_else(|| format!("expected a number, found \"{}\"", show(word)))?;
-        *slot = coordinate(v)?;
-    }
-    Ok(point)
 }
