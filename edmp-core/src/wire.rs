@@ -387,7 +387,7 @@ mod tests {
     }
 
     fn cloud(n: usize) -> (std::vec::Vec<Element>, std::vec::Vec<Node>) {
-        use crate::surface::bvh::{build, nodes_for};
+        use crate::surface::bvh::{Key, build, nodes_for};
         let mut pieces: std::vec::Vec<Element> = (0..n)
             .map(|i| {
                 Element::ball(
@@ -399,7 +399,8 @@ mod tests {
             })
             .collect();
         let mut nodes = std::vec![Node::EMPTY; nodes_for(n)];
-        let used = build(&mut pieces, &mut nodes).unwrap();
+        let mut keys = std::vec![Key::EMPTY; n];
+        let used = build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys).unwrap();
         nodes.truncate(used);
         (pieces, nodes)
     }

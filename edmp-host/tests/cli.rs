@@ -333,7 +333,7 @@ fn plan_refuses_every_bad_input_by_name_with_exit_2_and_writes_nothing() {
 /// constructors (independent of the host's parser). Clouds and meshes: inline vertices or an
 /// ASCII PLY beside the examples, in the world frame (no placement), no robot filter.
 fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene<'static> {
-    use edmp_core::surface::bvh::{Node, build, nodes_for};
+    use edmp_core::surface::bvh::{Key, Node, build, nodes_for};
     use edmp_core::surface::element::Element;
     let v3 = |v: &serde_json::Value| -> [f32; 3] { core::array::from_fn(|i| v[i].as_f64().unwrap() as f32) };
     let mut pieces = Vec::new();
@@ -367,7 +367,8 @@ fn scene_of(doc: &serde_json::Value) -> edmp_core::scene::Scene<'static> {
         return scene;
     }
     let mut nodes = vec![Node::EMPTY; nodes_for(pieces.len())];
-    let used = build(&mut pieces, &mut nodes).unwrap();
+    let mut keys = vec![Key::EMPTY; pieces.len()];
+    let used = build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys).unwrap();
     nodes.truncate(used);
     let (pieces, nodes): (&'static [Element], &'static [Node]) = (pieces.leak(), nodes.leak());
     let surface = edmp_core::surface::Surface::new(pieces, nodes).unwrap();

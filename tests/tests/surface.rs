@@ -10,7 +10,7 @@ use edmp_core::robot::kinematics::forward_with;
 use edmp_core::robot::{BODIES, FRAMES, PANDA};
 use edmp_core::scene::Scene;
 use edmp_core::surface::Surface;
-use edmp_core::surface::bvh::{Node, build, nodes_for};
+use edmp_core::surface::bvh::{Key, Node, build, nodes_for};
 use edmp_core::surface::element::Element;
 use nalgebra::Vector3;
 use proptest::prelude::*;
@@ -55,7 +55,8 @@ fn nearest_other(q: &[f32; 7], b: usize, p: &Element) -> f32 {
 
 fn checked(pieces: &mut [Element], q: &[f32; 7]) -> Option<Contact> {
     let mut nodes = vec![Node::EMPTY; nodes_for(pieces.len())];
-    let used = build(pieces, &mut nodes).unwrap();
+    let mut keys = vec![Key::EMPTY; pieces.len()];
+    let used = build(&pieces.to_vec(), pieces, &mut nodes, &mut keys).unwrap();
     let surface = Surface::new(pieces, &nodes[..used]).unwrap();
     let scene = Scene::<4>::new().with_surface(surface, &[]);
     check_end(&scene, q, &CheckConfig::default()).unwrap()

@@ -100,7 +100,7 @@ fn fitted(surface: &Surface<'_>, node: &Node) -> Option<Obstacle> {
 mod tests {
     use super::*;
     use crate::collision::convex::Solid;
-    use crate::surface::bvh::{build, nodes_for};
+    use crate::surface::bvh::{Key, build, nodes_for};
     use crate::surface::element::Element;
     use std::vec::Vec;
 
@@ -115,7 +115,8 @@ mod tests {
             })
             .collect();
         let mut nodes = std::vec![Node::EMPTY; nodes_for(5000)];
-        let used = build(&mut pieces, &mut nodes).unwrap();
+        let mut keys = std::vec![Key::EMPTY; 5000];
+        let used = build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys).unwrap();
         let surface = Surface::new(&pieces, &nodes[..used]).unwrap();
         let mut out = [Obstacle::sphere([0.0; 3], 1.0).unwrap(); 1];
         assert_eq!(covers(&surface, &mut out), 1);

@@ -3,7 +3,7 @@
 //! a node's children sit side by side in the node buffer. Median splits along the longest axis
 //! of the centroids keep the depth at about log₂ of the piece count.
 
-use crate::surface::element::{Aabb, Element, Piece, SurfaceError};
+use crate::surface::element::{Aabb, Element, SurfaceError};
 
 /// A leaf holds at most this many pieces.
 pub const LEAF: usize = 4;
@@ -53,94 +53,114 @@ pub const fn nodes_for(pieces: usize) -> usize {
     if pieces == 0 { 1 } else { pieces }
 }
 
-/// One pass over a run: the box of its pieces, and the box of their centroids (where it is
-/// split). Plain arrays: this loop is most of a build's time.
-fn boxes_of(run: &[Element]) -> (Aabb, Aabb) {
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    let (mut clo, mut chi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for e in run {
-        let (elo, ehi, c) = match &e.piece {
-            Piece::Ball { center, radius } => {
-                let c = [center.x, center.y, center.z];
-                (c.map(|x| x - radius), c.map(|x| x + radius), c)
-            }
-            Piece::Triangle { corners: [a, b, c] } => {
-                let lo = [a.x.min(b.x).min(c.x), a.y.min(b.y).min(c.y), a.z.min(b.z).min(c.z)];
-                let hi = [a.x.max(b.x).max(c.x), a.y.max(b.y).max(c.y), a.z.max(b.z).max(c.z)];
-                let m = (a + b + c) / 3.0;
-                (lo, hi, [m.x, m.y, m.z])
-            }
-        };
-        for k in 0..3 {
-            lo[k] = lo[k].min(elo[k]);
-            hi[k] = hi[k].max(ehi[k]);
-            clo[k] = clo[k].min(c[k]);
-            chi[k] = chi[k].max(c[k]);
-        }
-    }
-    let aabb = |lo: [f32; 3], hi: [f32; 3]| Aabb {
-        lo: lo.into(),
-        hi: hi.into(),
-    };
-    (aabb(lo, hi), aabb(clo, chi))
+/// A piece as the build sorts it: its centroid and its index in the piece buffer. The build
+/// moves these 16-byte keys instead of the pieces, and moves each piece once at the end.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Key {
+    centroid: [f32; 3],
+    piece: u32,
 }
 
-/// Moves the pieces for which `left` holds to the front, keeping no order; returns how many.
-fn partition(run: &mut [Element], left: impl Fn(&Element) -> bool) -> usize {
-    let mut front = 0;
-    for i in 0..run.len() {
-        if run.get(i).is_some_and(&left) {
-            run.swap(front, i);
-            front += 1;
+impl Key {
+    /// Fills key buffers before [`build`] writes them.
+    pub const EMPTY: Self = Self {
+        centroid: [0.0; 3],
+        piece: 0,
+    };
+
+    /// The key of piece number `piece`, whose centroid (finite) is `centroid`.
+    pub const fn new(centroid: [f32; 3], piece: u32) -> Self {
+        Self { centroid, piece }
+    }
+
+    /// The number the piece was given.
+    pub const fn piece(&self) -> u32 {
+        self.piece
+    }
+}
+
+/// The box of the centroids of `keys`, as (lo, hi). Centroids are finite (pieces are
+/// validated), so a plain comparison does what `f32::min` does, without its NaN handling.
+fn centroid_box(keys: &[Key]) -> ([f32; 3], [f32; 3]) {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for key in keys {
+        for k in 0..3 {
+            let c = key.centroid[k];
+            lo[k] = if c < lo[k] { c } else { lo[k] };
+            hi[k] = if c > hi[k] { c } else { hi[k] };
         }
+    }
+    (lo, hi)
+}
+
+/// Moves the keys whose centroid lies below `middle` on `axis` to the front, keeping no order;
+/// returns how many. No branch on the side (every key is swapped, only the cursor moves on
+/// the side): on a cloud the side is a coin toss, and a mispredicted branch per key would cost
+/// more than the pass.
+fn partition(keys: &mut [Key], axis: usize, middle: f32) -> usize {
+    let mut front = 0;
+    for i in 0..keys.len() {
+        let (Some(&key), Some(&first)) = (keys.get(i), keys.get(front)) else {
+            break;
+        };
+        if let Some(slot) = keys.get_mut(i) {
+            *slot = first;
+        }
+        if let Some(slot) = keys.get_mut(front) {
+            *slot = key;
+        }
+        front += usize::from(key.centroid[axis] < middle);
     }
     front
 }
 
-/// Builds the tree over `pieces` (reordering them) into `nodes`; returns the number of nodes
-/// used. Deterministic: the same pieces give the same tree on every target.
-pub fn build(pieces: &mut [Element], nodes: &mut [Node]) -> Result<usize, SurfaceError> {
-    if pieces.len() > u32::MAX as usize {
+/// Orders `keys` as the tree's leaves hold them and writes the tree's nodes (their runs, not
+/// yet their boxes: [`bound`] fills those once the pieces are in this order); returns the
+/// number of nodes used. Deterministic: the same keys give the same tree on every target.
+///
+/// Each node is split at the middle of its centroids' extent along the longest axis, or at
+/// the median when the middle leaves fewer than an eighth on one side.
+pub fn split(keys: &mut [Key], nodes: &mut [Node]) -> Result<usize, SurfaceError> {
+    if keys.len() > u32::MAX as usize {
         return Err(SurfaceError::TooManyPieces);
     }
-    if nodes.len() < nodes_for(pieces.len()) {
+    if nodes.len() < nodes_for(keys.len()) {
         return Err(SurfaceError::TooFewNodes);
     }
     let mut used = 1;
-    // Nodes still to fill: (node, first, count); a split pushes two, the depth bounds the stack.
+    // Nodes still to split: (node, first, count); a split pushes two, the depth bounds the stack.
     let mut todo = [(0usize, 0usize, 0usize); MAX_DEPTH + 1];
-    todo[0] = (0, 0, pieces.len());
+    todo[0] = (0, 0, keys.len());
     let mut depth = 1;
     while depth > 0 {
         depth -= 1;
         let (at, first, count) = todo[depth];
-        let Some(run) = pieces.get_mut(first..first + count) else {
+        let Some(run) = keys.get_mut(first..first + count) else {
             return Err(SurfaceError::TooManyPieces);
         };
-        let (b, c) = boxes_of(run);
         let mut node = Node {
-            lo: b.lo.into(),
-            hi: b.hi.into(),
             first: first as u32,
             count: count as u32,
-            left: 0,
+            ..Node::EMPTY
         };
         if count > LEAF && depth + 2 <= MAX_DEPTH && used + 2 <= nodes.len() {
-            let extent = c.hi - c.lo;
-            let axis = if extent.x >= extent.y && extent.x >= extent.z {
+            let (clo, chi) = centroid_box(run);
+            let extent: [f32; 3] = core::array::from_fn(|k| chi[k] - clo[k]);
+            let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
                 0
-            } else if extent.y >= extent.z {
+            } else if extent[1] >= extent[2] {
                 1
             } else {
                 2
             };
-            // Split at the middle of the centroids' extent (one pass); when that leaves
-            // fewer than an eighth on one side, at the median instead.
-            let middle = 0.5 * (c.lo[axis] + c.hi[axis]);
-            let mut mid = partition(run, |e| e.centroid()[axis] < middle);
-            if mid < count / 8 || mid > count - count / 8 {
+            let middle = 0.5 * (clo[axis] + chi[axis]);
+            let mut mid = partition(run, axis, middle);
+            // At least an eighth on each side, and two: every leaf then holds two or more
+            // pieces (so `nodes_for` suffices) and equal centroids cannot chain empty nodes.
+            let least = (count / 8).max(2);
+            if mid < least || mid > count - least {
                 mid = count / 2;
-                run.select_nth_unstable_by(mid, |a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]));
+                run.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
             }
             node.left = used as u32;
             todo[depth] = (used, first, mid);
@@ -151,6 +171,61 @@ pub fn build(pieces: &mut [Element], nodes: &mut [Node]) -> Result<usize, Surfac
         if let Some(slot) = nodes.get_mut(at) {
             *slot = node;
         }
+    }
+    Ok(used)
+}
+
+/// Fills the boxes of the nodes [`split`] wrote, over the pieces in the keys' order. Children
+/// come after their parent: one backward pass fills every box from below.
+pub fn bound(pieces: &[Element], nodes: &mut [Node]) {
+    for i in (0..nodes.len()).rev() {
+        let Some(&node) = nodes.get(i) else { continue };
+        let b = if node.left == 0 {
+            let end = node.first as usize + node.count as usize;
+            pieces
+                .get(node.first as usize..end)
+                .unwrap_or(&[])
+                .iter()
+                .fold(Aabb::EMPTY, |b, e| b.union(&e.bounds()))
+        } else {
+            let child = |k: u32| nodes.get(k as usize).map_or(Aabb::EMPTY, Node::bounds);
+            child(node.left).union(&child(node.left + 1))
+        };
+        if let Some(slot) = nodes.get_mut(i) {
+            slot.lo = b.lo.into();
+            slot.hi = b.hi.into();
+        }
+    }
+}
+
+/// Builds the tree over `input` into `nodes`, writing the pieces in the tree's order to
+/// `pieces` (at least as long as `input`), with `keys` (as long as `input`) as scratch;
+/// returns the number of nodes used: [`split`], each piece copied once to its place, [`bound`].
+/// A caller that makes its pieces from other data (a cloud's points) can skip `input`: keys
+/// from that data, [`split`], the pieces made in the keys' order, [`bound`].
+pub fn build(
+    input: &[Element],
+    pieces: &mut [Element],
+    nodes: &mut [Node],
+    keys: &mut [Key],
+) -> Result<usize, SurfaceError> {
+    if input.len() > u32::MAX as usize || pieces.len() < input.len() {
+        return Err(SurfaceError::TooManyPieces);
+    }
+    let Some(keys) = keys.get_mut(..input.len()) else {
+        return Err(SurfaceError::TooFewKeys);
+    };
+    for (i, (key, e)) in keys.iter_mut().zip(input.iter()).enumerate() {
+        *key = Key::new(e.centroid().into(), i as u32);
+    }
+    let used = split(keys, nodes)?;
+    for (slot, key) in pieces.iter_mut().zip(keys.iter()) {
+        if let Some(e) = input.get(key.piece as usize) {
+            *slot = *e;
+        }
+    }
+    if let Some(nodes) = nodes.get_mut(..used) {
+        bound(pieces.get(..input.len()).unwrap_or(&[]), nodes);
     }
     Ok(used)
 }
@@ -169,7 +244,8 @@ mod tests {
             })
             .collect();
         let mut nodes = std::vec![Node::EMPTY; nodes_for(1000)];
-        let used = build(&mut pieces, &mut nodes).unwrap();
+        let mut keys = std::vec![Key::EMPTY; 1000];
+        let used = build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys).unwrap();
         assert!(used < 1000);
         let mut covered = 0;
         for n in &nodes[..used] {
@@ -191,6 +267,13 @@ mod tests {
         }
         assert_eq!(covered, 1000);
         let mut short = [nodes[0]; 10];
-        assert_eq!(build(&mut pieces, &mut short), Err(SurfaceError::TooFewNodes));
+        assert_eq!(
+            build(&pieces.clone(), &mut pieces, &mut short, &mut keys),
+            Err(SurfaceError::TooFewNodes)
+        );
+        assert_eq!(
+            build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys[..999]),
+            Err(SurfaceError::TooFewKeys)
+        );
     }
 }

@@ -18,6 +18,8 @@ pub enum SurfaceError {
     TooManyPieces,
     /// The node buffer is too short for the pieces (it needs [`crate::surface::bvh::nodes_for`]).
     TooFewNodes,
+    /// The build's key buffer is shorter than the pieces.
+    TooFewKeys,
 }
 
 impl core::fmt::Display for SurfaceError {
@@ -28,6 +30,7 @@ impl core::fmt::Display for SurfaceError {
             Self::IndexOutOfRange => "triangle index out of range",
             Self::TooManyPieces => "more points or triangles than the planner's capacity",
             Self::TooFewNodes => "node buffer too short for the pieces",
+            Self::TooFewKeys => "key buffer too short for the pieces",
         })
     }
 }

@@ -208,7 +208,8 @@ mod tests {
             .map(|i| Element::ball([0.5, (i % 100) as f32 * 0.01 - 0.5, (i / 100) as f32 * 0.01], 0.0075, 2).unwrap())
             .collect();
         let mut nodes = std::vec![Node::EMPTY; bvh::nodes_for(pieces.len())];
-        let used = bvh::build(&mut pieces, &mut nodes).unwrap();
+        let mut keys = std::vec![bvh::Key::EMPTY; pieces.len()];
+        let used = bvh::build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys).unwrap();
         nodes.truncate(used);
         (pieces, nodes)
     }

@@ -340,6 +340,12 @@ pub(crate) fn parse(bytes: &[u8], faces: bool) -> Result<PlyData, FileError> {
                 ));
             }
         }
+        if is_vertex {
+            // A binary count was checked against the bytes above; an ASCII row takes at
+            // least two bytes a property.
+            let rows = element.count.min(bytes.len() / (2 * element.properties.len()));
+            data.vertices.reserve(rows);
+        }
         for row in 0..element.count {
             let mut point = [0.0f32; 3];
             for (i, property) in element.properties.iter().enumerate() {
