@@ -53,8 +53,8 @@ pub const fn nodes_for(pieces: usize) -> usize {
     if pieces == 0 { 1 } else { pieces }
 }
 
-/// A piece as the build sorts it: its centroid and its index in the piece buffer. The build
-/// moves these 16-byte keys instead of the pieces, and moves each piece once at the end.
+/// A piece as the build sorts it: its centroid and the number its caller gave it. The build
+/// moves these 16-byte keys instead of the pieces, which are then put in place once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Key {
     centroid: [f32; 3],
@@ -119,7 +119,7 @@ fn partition(keys: &mut [Key], axis: usize, middle: f32) -> usize {
 /// number of nodes used. Deterministic: the same keys give the same tree on every target.
 ///
 /// Each node is split at the middle of its centroids' extent along the longest axis, or at
-/// the median when the middle leaves fewer than an eighth on one side.
+/// the median when the middle leaves fewer than an eighth (or two) on one side.
 pub fn split(keys: &mut [Key], nodes: &mut [Node]) -> Result<usize, SurfaceError> {
     if keys.len() > u32::MAX as usize {
         return Err(SurfaceError::TooManyPieces);

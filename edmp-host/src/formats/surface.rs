@@ -342,8 +342,7 @@ pub fn build_surfaces(
         .count();
     let mut room = MAX_PIECES - triangles;
     let mut reduced = Vec::new();
-    // Per obstacle: the reduced copy of a cloud beyond its share (None: kept as read), and the
-    // valid triangles of a mesh.
+    // Per obstacle, what its pieces are made from (`Held`).
     let mut held = Vec::with_capacity(obstacles.len());
     for o in obstacles.iter_mut() {
         let path = format!("obstacles[{}]", o.index);
@@ -526,4 +525,65 @@ pub fn inside_closed_mesh(surfaces: &Surfaces, q: &Joints<f32>, finger: f32) -> 
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use edmp_core::surface::element::Piece;
+
+    #[test]
+    fn a_cloud_beyond_the_capacity_is_reduced_to_cover_it_and_a_mesh_beside_it_is_kept() {
+        // 300,304 points 2 mm apart on a wall at x = 0.6, and one triangle.
+        let side = 548;
+        let points: Vec<[f32; 3]> = (0..side * side)
+            .map(|i| [0.6, (i % side) as f32 * 0.002 - 0.5, (i / side) as f32 * 0.002])
+            .collect();
+        let cloud = SurfaceObstacle {
+            index: 0,
+            kind: SurfaceKind::Points {
+                points: points.clone(),
+                radius: 0.0075,
+                filter_robot: None,
+            },
+        };
+        let mesh = SurfaceObstacle {
+            index: 1,
+            kind: SurfaceKind::Mesh {
+                vertices: vec![[0.3, -0.5, 0.0], [0.3, 0.5, 0.0], [0.3, 0.0, 1.0]],
+                triangles: vec![[0, 1, 2]],
+            },
+        };
+        let s = build_surfaces(vec![cloud, mesh], &[0.0; 7], 0.025).unwrap();
+        assert!(s.pieces() <= MAX_PIECES && s.pieces() > 1);
+        assert!(Surface::new(&s.pieces, &s.nodes).is_ok());
+        let [(0, r)] = s.reduced[..] else {
+            panic!("{:?}", s.reduced)
+        };
+        assert!(r.cell > 0.0 && r.radius > 0.0075);
+        let mut balls = Vec::new();
+        let mut triangles = 0;
+        for e in &s.pieces {
+            match e.piece {
+                Piece::Ball { center, radius } => balls.push((center, radius, e.obstacle)),
+                Piece::Triangle { .. } => triangles += usize::from(e.obstacle == 1),
+            }
+        }
+        assert_eq!(triangles, 1);
+        // Every input ball (a sample) lies inside a reduced ball of the cloud.
+        for p in points.iter().step_by(997) {
+            let p = Vector3::from(*p);
+            assert!(
+                balls
+                    .iter()
+                    .any(|(c, radius, o)| *o == 0 && (c - p).norm() + 0.0075 <= radius + 1e-6),
+                "{p:?} not covered"
+            );
+        }
+        // The obstacle keeps its points as read.
+        let SurfaceKind::Points { points: kept, .. } = &s.obstacles[0].kind else {
+            panic!()
+        };
+        assert_eq!(kept.len(), side * side);
+    }
 }
