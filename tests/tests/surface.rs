@@ -56,7 +56,8 @@ fn nearest_other(q: &[f32; 7], b: usize, p: &Element) -> f32 {
 fn checked(pieces: &mut [Element], q: &[f32; 7]) -> Option<Contact> {
     let mut nodes = vec![Node::EMPTY; nodes_for(pieces.len())];
     let mut keys = vec![Key::EMPTY; pieces.len()];
-    let used = build(&pieces.to_vec(), pieces, &mut nodes, &mut keys).unwrap();
+    let input = pieces.to_vec();
+    let used = build(&input, pieces, &mut nodes, &mut keys).unwrap();
     let surface = Surface::new(pieces, &nodes[..used]).unwrap();
     let scene = Scene::<4>::new().with_surface(surface, &[]);
     check_end(&scene, q, &CheckConfig::default()).unwrap()
