@@ -5,8 +5,9 @@
 
 use crate::surface::element::{Aabb, Element, SurfaceError};
 
-/// A leaf holds at most this many pieces.
-pub const LEAF: usize = 4;
+/// A leaf holds at most this many pieces, and a split leaves at least half as many on each
+/// side.
+pub const LEAF: usize = 16;
 
 /// The deepest a tree may be: a median split halves the run, so 2⁴⁰ pieces would still fit.
 pub const MAX_DEPTH: usize = 40;
@@ -47,10 +48,12 @@ impl Node {
     }
 }
 
-/// How many nodes a tree over `pieces` pieces can need: a run is split only above [`LEAF`]
-/// pieces, so every leaf holds at least two and there are fewer than `pieces` nodes.
+/// How many nodes a tree over `pieces` pieces can need: a split leaves at least `LEAF / 2`
+/// pieces on each side, so a tree has at most `pieces / (LEAF / 2)` leaves and fewer than
+/// twice as many nodes.
 pub const fn nodes_for(pieces: usize) -> usize {
-    if pieces == 0 { 1 } else { pieces }
+    let most = 2 * (pieces / (LEAF / 2));
+    if most == 0 { 1 } else { most }
 }
 
 /// A piece as the build sorts it: its centroid and the number its caller gave it. The build
@@ -155,9 +158,9 @@ pub fn split(keys: &mut [Key], nodes: &mut [Node]) -> Result<usize, SurfaceError
             };
             let middle = 0.5 * (clo[axis] + chi[axis]);
             let mut mid = partition(run, axis, middle);
-            // At least an eighth on each side, and two: every leaf then holds two or more
-            // pieces (so `nodes_for` suffices) and equal centroids cannot chain empty nodes.
-            let least = (count / 8).max(2);
+            // At least an eighth on each side, and half a leaf: every leaf then holds that
+            // many (so `nodes_for` suffices) and equal centroids cannot chain empty nodes.
+            let least = (count / 8).max(LEAF / 2);
             if mid < least || mid > count - least {
                 mid = count / 2;
                 run.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
@@ -235,18 +238,13 @@ mod tests {
     use super::*;
     use std::vec::Vec;
 
-    #[test]
-    fn every_node_holds_its_run_and_leaves_partition_the_pieces() {
-        let mut pieces: Vec<Element> = (0..1000)
-            .map(|i| {
-                let f = i as f32;
-                Element::ball([libm::sinf(f) * 0.5, libm::cosf(f * 1.3) * 0.4, f * 1e-3], 0.01, 0).unwrap()
-            })
-            .collect();
-        let mut nodes = std::vec![Node::EMPTY; nodes_for(1000)];
-        let mut keys = std::vec![Key::EMPTY; 1000];
-        let used = build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys).unwrap();
-        assert!(used < 1000);
+    /// Checks the tree over `pieces` and returns how many nodes it has.
+    fn checked_tree(pieces: &mut [Element]) -> usize {
+        let count = pieces.len();
+        let mut nodes = std::vec![Node::EMPTY; nodes_for(count)];
+        let mut keys = std::vec![Key::EMPTY; count];
+        let input = pieces.to_vec();
+        let used = build(&input, pieces, &mut nodes, &mut keys).unwrap();
         let mut covered = 0;
         for n in &nodes[..used] {
             let b = n.bounds();
@@ -255,8 +253,8 @@ mod tests {
                 assert!((0..3).all(|k| eb.lo[k] >= b.lo[k] && eb.hi[k] <= b.hi[k]));
             }
             if n.left == 0 {
-                assert!(n.count as usize <= LEAF);
-                covered += n.count;
+                assert!(n.count as usize <= LEAF && n.count as usize >= LEAF / 2);
+                covered += n.count as usize;
             } else {
                 let (l, r) = (nodes[n.left as usize], nodes[n.left as usize + 1]);
                 assert_eq!(
@@ -265,7 +263,30 @@ mod tests {
                 );
             }
         }
-        assert_eq!(covered, 1000);
+        assert_eq!(covered, count);
+        used
+    }
+
+    #[test]
+    fn equal_points_make_a_balanced_tree_of_full_leaves() {
+        // A camera's cloud repeats points; the middle of an empty extent splits nothing.
+        let mut pieces = std::vec![Element::ball([0.5, 0.0, 0.3], 0.01, 0).unwrap(); 1000];
+        assert!(checked_tree(&mut pieces) <= nodes_for(1000));
+    }
+
+    #[test]
+    fn every_node_holds_its_run_and_leaves_partition_the_pieces() {
+        let mut pieces: Vec<Element> = (0..1000)
+            .map(|i| {
+                let f = i as f32;
+                Element::ball([libm::sinf(f) * 0.5, libm::cosf(f * 1.3) * 0.4, f * 1e-3], 0.01, 0).unwrap()
+            })
+            .collect();
+        assert!(checked_tree(&mut pieces) <= nodes_for(1000));
+        let mut nodes = std::vec![Node::EMPTY; nodes_for(1000)];
+        let mut keys = std::vec![Key::EMPTY; 1000];
+        let used = build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys).unwrap();
+        assert!(used <= nodes_for(1000));
         let mut short = [nodes[0]; 10];
         assert_eq!(
             build(&pieces.clone(), &mut pieces, &mut short, &mut keys),

@@ -19,6 +19,7 @@ use edmp_core::planner::{Plan, PlanConfig, Request, Workspace, plan};
 use edmp_core::prior::Scratch;
 use edmp_core::rng::Rng;
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
+use edmp_core::surface::bvh::nodes_for;
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
 use edmp_core::wire::{Problem, WireSurface, decode, encode_surface, surface_bytes_max};
 use std::path::{Path, PathBuf};
@@ -72,8 +73,11 @@ pub struct Embedded {
     pub bytes: Vec<u8>,
 }
 
+/// Tree nodes the firmware holds: enough for any tree over [`FIRMWARE_PIECES`] pieces.
+pub const FIRMWARE_NODES: usize = nodes_for(FIRMWARE_PIECES);
+
 /// The decoded surface: the firmware's capacity.
-type Decoded = WireSurface<FIRMWARE_PIECES>;
+type Decoded = WireSurface<FIRMWARE_PIECES, FIRMWARE_NODES>;
 
 /// The wire problem of a scene file without clouds or meshes (those need [`embed_problem`]):
 /// validated by `parse_problem`, goal resolved to joints.
@@ -130,7 +134,8 @@ pub fn embed_problem(parsed: &json::Problem, seed: u64) -> Result<Embedded, Stri
     }
     // The firmware rebuilds the scene from these bytes: it must be the host's scene exactly.
     let mut decoded = Box::new(Decoded::new());
-    let back = decode::<MAX_OBSTACLES, FIRMWARE_PIECES>(&bytes, &mut decoded).map_err(|e| e.to_string())?;
+    let back =
+        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(&bytes, &mut decoded).map_err(|e| e.to_string())?;
     let rebuilt = back.to_scene_with(&decoded).map_err(|e| e.to_string())?;
     let scene = parsed.scene();
     if back != problem
@@ -150,7 +155,8 @@ pub fn embed_problem(parsed: &json::Problem, seed: u64) -> Result<Embedded, Stri
 /// configuration, guides, rows and seed.
 pub fn plan_like_firmware(bytes: &[u8]) -> Result<Plan<ROWS>, String> {
     let mut decoded = Box::new(Decoded::new());
-    let problem = decode::<MAX_OBSTACLES, FIRMWARE_PIECES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
+    let problem =
+        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
     let scene: Scene<MAX_OBSTACLES> = problem.to_scene_with(&decoded).map_err(|e| e.to_string())?;
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<ROWS>::new());
@@ -210,7 +216,8 @@ pub fn time_like_firmware(bytes: &[u8], plan: &Plan<ROWS>) -> Result<Option<u64>
         return Ok(None);
     };
     let mut decoded = Box::new(Decoded::new());
-    let problem = decode::<MAX_OBSTACLES, FIRMWARE_PIECES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
+    let problem =
+        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
     let scene: Scene<MAX_OBSTACLES> = problem.to_scene_with(&decoded).map_err(|e| e.to_string())?;
     let mut timed: Box<Timed> = Box::new(Timed::new());
     parameterize_checked(&scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, &mut timed)
@@ -241,7 +248,7 @@ mod tests {
             let e = embed_problem(&parsed, 0).unwrap();
             assert_eq!(e.problem.obstacles.len(), 3, "{file}");
             let mut decoded = Box::new(Decoded::new());
-            let back = decode::<MAX_OBSTACLES, FIRMWARE_PIECES>(&e.bytes, &mut decoded).unwrap();
+            let back = decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(&e.bytes, &mut decoded).unwrap();
             assert_eq!(back, e.problem);
             assert_eq!(decoded.pieces().len(), pieces, "{file}");
             let scene = back.to_scene_with(&decoded).unwrap();

@@ -34,6 +34,7 @@ use edmp_core::path::{HORIZON, Path};
 use edmp_core::rng::Rng;
 use edmp_core::robot::JOINTS;
 use edmp_core::scene::{Scene, SceneError};
+use edmp_core::surface::bvh::nodes_for;
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
 use edmp_core::wire::{Problem, WireError, WireSurface, decode as decode_wire};
 
@@ -61,9 +62,12 @@ const ROWS: usize = 12;
 /// (about 410 bytes of stack each, measured).
 const OBSTACLES: usize = 40;
 
-/// Pieces of a scene's clouds and meshes (balls and triangles together; as many tree nodes):
-/// `edmp-host embed` refuses more (its `FIRMWARE_PIECES`). About 72 bytes each, in `.bss`.
+/// Pieces of a scene's clouds and meshes (balls and triangles together): `edmp-host embed`
+/// refuses more (its `FIRMWARE_PIECES`). About 44 bytes each, in `.bss`.
 const PIECES: usize = 320;
+
+/// Tree nodes: as many as any tree over `PIECES` pieces has. 36 bytes each, in `.bss`.
+const NODES: usize = nodes_for(PIECES);
 
 /// The embedded scenes, in `edmp-host embed`'s order (scripts/firmware lists the same files).
 const SCENES: &[(&str, &[u8])] = &[
@@ -88,7 +92,7 @@ static mut WORK: Workspace<ROWS> = Workspace::new();
 /// The chosen path's time parameterization (`.bss`).
 static mut TIMED: Timed = Timed::new();
 /// The decoded pieces and tree of the scene's clouds and meshes (`.bss`).
-static mut SURFACE: WireSurface<PIECES> = WireSurface::new();
+static mut SURFACE: WireSurface<PIECES, NODES> = WireSurface::new();
 
 /// SysTick wraps (every 2^24 ticks), counted by its exception.
 static WRAPS: AtomicU32 = AtomicU32::new(0);
@@ -246,7 +250,7 @@ fn scene_error_name(e: SceneError) -> &'static str {
 fn wire_error_name(e: WireError) -> &'static str {
     match e {
         WireError::Decode => "bad postcard bytes (or more than OBSTACLES obstacles)",
-        WireError::Capacity => "more pieces or nodes than PIECES",
+        WireError::Capacity => "more pieces or nodes than PIECES or NODES",
         WireError::TooManyBoxes => "too many guide boxes",
         WireError::DegenerateTriangle => "surface: degenerate triangle",
         WireError::Surface(_) => "surface: a piece or the tree refused",
@@ -280,10 +284,10 @@ struct Summary {
 /// The problem and its scene, the scene's surface decoded into `surface`.
 fn decode<'a>(
     bytes: &[u8],
-    surface: &'a mut WireSurface<PIECES>,
+    surface: &'a mut WireSurface<PIECES, NODES>,
 ) -> Result<(Problem<OBSTACLES>, Scene<'a, OBSTACLES>), Failure> {
     let problem: Problem<OBSTACLES> = decode_wire(bytes, surface).map_err(Failure::Wire)?;
-    let surface: &'a WireSurface<PIECES> = surface;
+    let surface: &'a WireSurface<PIECES, NODES> = surface;
     let scene = problem.to_scene_with(surface).map_err(Failure::Wire)?;
     Ok((problem, scene))
 }
@@ -295,7 +299,7 @@ fn plan_scene(
     bytes: &[u8],
     scratch: &mut Scratch<1>,
     work: &mut Workspace<ROWS>,
-    surface: &mut WireSurface<PIECES>,
+    surface: &mut WireSurface<PIECES, NODES>,
 ) -> Result<Summary, Failure> {
     let (problem, scene) = decode(bytes, surface)?;
     let mut rng = Rng::new(problem.seed);
@@ -312,7 +316,7 @@ fn plan_scene(
 /// Times a free plan's path as the host's `--timed` does: the spline checked against the scene
 /// (else the polyline), Franka's limits, jerk-limited.
 #[inline(never)]
-fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed, surface: &mut WireSurface<PIECES>) -> Result<u64, Failure> {
+fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed, surface: &mut WireSurface<PIECES, NODES>) -> Result<u64, Failure> {
     let (_, scene) = decode(bytes, surface)?;
     parameterize_checked(&scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, timed).map_err(Failure::Plan)?;
     Ok(timed.fingerprint())
@@ -321,7 +325,7 @@ fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed, surface: &mut WireSur
 /// Ticks of one network evaluation of all 12 rows (noise between the scene's ends, step 255),
 /// to split a plan's instructions into network and the rest.
 #[inline(never)]
-fn time_network(bytes: &[u8], scratch: &mut Scratch<1>, surface: &mut WireSurface<PIECES>) -> Result<u64, Failure> {
+fn time_network(bytes: &[u8], scratch: &mut Scratch<1>, surface: &mut WireSurface<PIECES, NODES>) -> Result<u64, Failure> {
     let (problem, _) = decode(bytes, surface)?;
     let mut rng = Rng::new(problem.seed);
     let mut paths = [[[0.0f32; JOINTS]; HORIZON]; ROWS];
