@@ -330,7 +330,11 @@ mod tests {
             header.replace('3', "1").as_str(),
             &[0, 0, 0, 0, 0, 0, 0xc0, 0x7f, 0, 0, 0, 0],
         );
-        assert!(message(parse_ply_points(&nan)).starts_with("byte "));
+        let m = message(parse_ply_points(&nan));
+        assert!(
+            m.starts_with("byte ") && m.contains("row 0 property \"y\": coordinate NaN"),
+            "{m}"
+        );
         assert!(message(parse_ply_points(b"plyx\n")).contains("not a PLY file"));
         assert!(
             message(parse_ply_points(b"ply\nformat binary_big_endian 1.0\nend_header\n")).contains("not supported")

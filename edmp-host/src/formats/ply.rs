@@ -182,6 +182,38 @@ impl Body<'_> {
     }
 }
 
+/// Where one coordinate sits in a row of fixed size: its byte offset, type and property number.
+#[derive(Clone, Copy)]
+struct Field {
+    offset: usize,
+    scalar: Scalar,
+    property: usize,
+}
+
+/// Rows of one size (every property a scalar): the size in bytes and where x, y and z sit.
+struct FixedRows {
+    stride: usize,
+    xyz: [Field; 3],
+}
+
+/// `element`'s rows when every property is a scalar, x, y and z being the properties `xyz`.
+fn fixed_rows(element: &Element, xyz: [usize; 3]) -> Option<FixedRows> {
+    let mut fields = Vec::with_capacity(element.properties.len());
+    let mut stride = 0;
+    for (property, p) in element.properties.iter().enumerate() {
+        let Kind::Scalar(scalar) = p.kind else { return None };
+        fields.push(Field {
+            offset: stride,
+            scalar,
+            property,
+        });
+        stride += scalar.size();
+    }
+    let at = |i: usize| fields.get(i).copied();
+    let xyz = [at(xyz[0])?, at(xyz[1])?, at(xyz[2])?];
+    (stride > 0).then_some(FixedRows { stride, xyz })
+}
+
 /// The header: the body's encoding, the elements in order, and where the body starts.
 fn header(bytes: &[u8]) -> Result<(bool, Vec<Element>, usize), FileError> {
     let mut ascii = None;
@@ -345,6 +377,33 @@ pub(crate) fn parse(bytes: &[u8], faces: bool) -> Result<PlyData, FileError> {
             // least two bytes a property.
             let rows = element.count.min(bytes.len() / (2 * element.properties.len()));
             data.vertices.reserve(rows);
+        }
+        if is_vertex
+            && let Body::Binary { bytes, pos } = &mut body
+            && let Some(FixedRows { stride, xyz }) = fixed_rows(element, [ix, iy, iz])
+        {
+            // Every row the same size: x, y and z read straight from each row's bytes.
+            let start = *pos;
+            let need = element.count.saturating_mul(stride);
+            let rows = bytes.get(start..start.saturating_add(need)).unwrap_or(&[]);
+            for (row, chunk) in rows.chunks_exact(stride).enumerate() {
+                let mut point = [0.0f32; 3];
+                for (slot, field) in point.iter_mut().zip(&xyz) {
+                    let (offset, s) = (field.offset, field.scalar);
+                    let value = chunk.get(offset..offset + s.size()).map_or(f64::NAN, |b| s.decode(b));
+                    *slot = coordinate(value).map_err(|m| {
+                        let name = element.properties.get(field.property).map_or("", |p| p.name.as_str());
+                        FileError::new(
+                            Where::Byte(start + row * stride + offset),
+                            format!("element \"vertex\" row {row} property \"{name}\": {m}"),
+                        )
+                    })?;
+                }
+                data.vertices.push(point);
+            }
+            *pos = start + need;
+            have_vertices = true;
+            continue;
         }
         for row in 0..element.count {
             let mut point = [0.0f32; 3];
