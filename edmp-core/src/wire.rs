@@ -198,7 +198,7 @@ fn take<'b, T: Deserialize<'b>>(bytes: &'b [u8]) -> Result<(T, &'b [u8]), WireEr
 /// The decoded pieces (at most `P`, balls and triangles of every cloud and mesh together), the
 /// tree over them (at most `T` nodes: [`crate::surface::bvh::nodes_for`]`(P)` holds any tree
 /// the host builds over `P` pieces) and the guide boxes' limit. Big (about 44 bytes a piece and
-/// 40 a node): firmware keeps it in a `static`.
+/// 36 a node): firmware keeps it in a `static`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WireSurface<const P: usize, const T: usize = P> {
     pieces: heapless::Vec<Element, P>,
