@@ -2,7 +2,7 @@
 //! finite-difference oracle for the kinematics adjoint (also used by `fuzz/`).
 
 use edmp_core::robot::kinematics::{CORNERS, CornerGradient, forward};
-use edmp_core::robot::{BODIES, JOINTS};
+use edmp_core::robot::{BODIES, JOINTS, PANDA, PANDA_F64};
 use nalgebra::Vector3;
 use serde::Deserialize;
 
@@ -49,7 +49,7 @@ pub fn gradient_scale(g: &CornerGradient<f32>) -> f64 {
 
 /// `L(q) = Σ g·corner(q)` in f64, the scalar whose gradient the adjoint computes.
 fn corner_objective(q: &[f64; JOINTS], g: &CornerGradient<f32>) -> f64 {
-    let k = forward(q).expect("finite joints");
+    let k = forward(&PANDA_F64, q).expect("finite joints");
     let mut total = 0.0;
     for (b, grads) in g.iter().enumerate() {
         for (corner, grad) in k.corners(b).iter().zip(grads.iter()) {
@@ -77,7 +77,7 @@ pub const ADJOINT_REL_TOL: f64 = 1e-5;
 
 /// Compares the f32 adjoint with f64 central differences; `Err` describes the worst joint.
 pub fn check_adjoint(q: &[f32; JOINTS], g: &CornerGradient<f32>) -> Result<(), String> {
-    let k = forward(q).map_err(|e| format!("forward: {e}"))?;
+    let k = forward(&PANDA, q).map_err(|e| format!("forward: {e}"))?;
     let adjoint = k.adjoint(g).map_err(|e| format!("adjoint: {e}"))?;
     let q64 = q.map(f64::from);
     let fd = finite_difference(&q64, g, 1e-6);
@@ -168,7 +168,8 @@ pub mod reference {
     /// Every moving robot box's 8 world corners at `q` (bodies off the root, then the held object).
     fn robot_corners(q: &[f64; JOINTS], scene: &Scene<16>, cfg: &CostConfig) -> Vec<Vec<Vector3<f64>>> {
         // The scene's finger opening (in f64, from the scene's f32) places the finger boxes.
-        let k = forward_with(q, f64::from(scene.gripper())).expect("finite, opening validated");
+        let k = forward_with(&edmp_core::robot::PANDA_F64, q, f64::from(scene.gripper()))
+            .expect("finite, opening validated");
         let mut out = Vec::new();
         for b in 0..BODIES {
             if PANDA.bodies[b].frame == 0 {

@@ -4,6 +4,7 @@
 //! text instantiates both the `f32` robot (the planner) and the `f64` robot (finite-difference
 //! oracles and tests); the compiler rounds each literal once.
 
+use crate::arms::{LimitSource, PairRule};
 use crate::math::{self, Mat3, Vec3};
 use crate::urdf::{Chain, FINGER_OPENING, Motion};
 use core::fmt::Write;
@@ -22,8 +23,8 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     wl(
         w,
         &format!(
-            "// Finger frames are their fixed transform at opening 0 plus `slide` times the opening w, an input \
-             (the scene's `gripper.finger`, default {FINGER_OPENING} m, docs/formats.md)."
+            "// Finger frames (if any) are their fixed transform at opening 0 plus `slide` times the opening w, \
+             an input (the scene's `gripper.finger`, default {FINGER_OPENING} m, docs/formats.md)."
         ),
     );
     wl(w, "");
@@ -49,26 +50,28 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         ),
     );
     wl(w, &format!("pub const HAND_FRAME: usize = {};", chain.hand));
-    wl(
-        w,
-        "/// Default opening of each finger, metres: what an absent `gripper` field means (docs/formats.md).",
-    );
-    wl(
-        w,
-        &format!("pub const FINGER_OPENING_DEFAULT: f32 = {};", lit(FINGER_OPENING)),
-    );
-    let [lower, upper] = chain.finger_limits;
-    let driver = &chain.finger_joint;
-    wl(
-        w,
-        &format!("/// Smallest opening of each finger, metres: `<limit lower>` of `{driver}`."),
-    );
-    wl(w, &format!("pub const FINGER_OPENING_MIN: f32 = {};", lit(lower)));
-    wl(
-        w,
-        &format!("/// Largest opening of each finger, metres: `<limit upper>` of `{driver}`."),
-    );
-    wl(w, &format!("pub const FINGER_OPENING_MAX: f32 = {};", lit(upper)));
+    if let Some(gripper) = &chain.gripper {
+        wl(
+            w,
+            "/// Default opening of each finger, metres: what an absent `gripper` field means (docs/formats.md).",
+        );
+        wl(
+            w,
+            &format!("pub const FINGER_OPENING_DEFAULT: f32 = {};", lit(FINGER_OPENING)),
+        );
+        let [lower, upper] = gripper.limits;
+        let driver = &gripper.joint;
+        wl(
+            w,
+            &format!("/// Smallest opening of each finger, metres: `<limit lower>` of `{driver}`."),
+        );
+        wl(w, &format!("pub const FINGER_OPENING_MIN: f32 = {};", lit(lower)));
+        wl(
+            w,
+            &format!("/// Largest opening of each finger, metres: `<limit upper>` of `{driver}`."),
+        );
+        wl(w, &format!("pub const FINGER_OPENING_MAX: f32 = {};", lit(upper)));
+    }
     wl(w, "/// URDF link name of each frame.");
     let names: Vec<_> = chain.frames.iter().map(|f| format!("{:?}", f.name)).collect();
     wl(
@@ -93,15 +96,34 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         w,
         &format!("pub const JOINT_NAMES: [&str; JOINTS] = [{}];", names.join(", ")),
     );
+    let rule = match chain.arm.pairs {
+        PairRule::Levels => "bodies two or more revolute joints apart",
+        PairRule::ApartAtZero => "links that are not parent and child and do not touch at the all-zero configuration",
+    };
+    wl(
+        w,
+        &format!("/// Number of body pairs checked against each other ({rule})."),
+    );
+    wl(w, &format!("pub const SELF_PAIRS: usize = {};", chain.self_pairs.len()));
+    wl(w, "/// The body pairs checked against each other, `a < b`.");
+    let pairs: Vec<_> = chain.self_pairs.iter().map(|(a, b)| format!("({a}, {b})")).collect();
+    wl(
+        w,
+        &format!(
+            "pub const SELF_PAIR_TABLE: [(u8, u8); SELF_PAIRS] = [{}];",
+            pairs.join(", ")
+        ),
+    );
     wl(w, "");
     wl(
         w,
-        "/// The robot tables, instantiated for `f32` and `f64` by `robot.rs`.",
+        "/// The robot tables, instantiated for `f32` and `f64` by `robot::arms`.",
     );
-    wl(w, "macro_rules! panda_tables {");
+    wl(w, "macro_rules! tables {");
     wl(w, "    () => {");
     wl(w, "        Robot {");
-    wl(w, "            frames: [");
+    wl(w, &format!("            name: {:?},", chain.arm.name));
+    wl(w, "            frames: &[");
     for (i, f) in chain.frames.iter().enumerate() {
         wl(w, &format!("                // [{i}] `{}`: {}", f.name, f.provenance));
         let mut slide = None;
@@ -150,7 +172,7 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         wl(w, "                },");
     }
     wl(w, "            ],");
-    wl(w, "            bodies: [");
+    wl(w, "            bodies: &[");
     let mut hull_start = 0;
     for b in &chain.bodies {
         let shrink = 100.0 * (1.0 - b.tight.volume() / b.aabb.volume());
@@ -186,7 +208,7 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         hull_start += b.points.len();
     }
     wl(w, "            ],");
-    wl(w, "            hull_points: [");
+    wl(w, "            hull_points: &[");
     for b in &chain.bodies {
         let note = format!(
             "the {} convex-hull vertices of `{}`, in its link frame",
@@ -199,10 +221,20 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         }
     }
     wl(w, "            ],");
+    wl(w, "            self_pairs: &SELF_PAIR_TABLE,");
+    wl(w, "            frame_names: &FRAME_NAMES,");
+    wl(w, "            body_names: &BODY_NAMES,");
+    wl(w, "            joint_names: JOINT_NAMES,");
+    wl(w, "            tcp_frame: TCP_FRAME,");
+    wl(w, "            hand_frame: HAND_FRAME,");
     let limits = |pick: &dyn Fn(usize) -> f64| (0..n_joints).map(|i| lit(pick(i))).collect::<Vec<_>>().join(", ");
+    let planning = match chain.arm.limits {
+        LimitSource::SafetyController => "<safety_controller soft_lower_limit / soft_upper_limit>",
+        LimitSource::Limit => "<limit lower / upper> (the URDF has no other range)",
+    };
     wl(
         w,
-        "            // <safety_controller soft_lower_limit / soft_upper_limit> of each joint: the planning range.",
+        &format!("            // {planning} of each joint: the planning range."),
     );
     wl(
         w,
@@ -224,13 +256,28 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         w,
         &format!("            hard_upper: [{}],", limits(&|i| chain.joints[i].hard[1])),
     );
-    wl(
-        w,
-        &format!("            // The finger opening: the spec's default, and `<limit lower / upper>` of `{driver}`."),
-    );
-    wl(w, &format!("            finger_default: {},", lit(FINGER_OPENING)));
-    wl(w, &format!("            finger_lower: {},", lit(lower)));
-    wl(w, &format!("            finger_upper: {},", lit(upper)));
+    match &chain.gripper {
+        Some(gripper) => {
+            let [lower, upper] = gripper.limits;
+            wl(
+                w,
+                &format!(
+                    "            // The finger opening: the spec's default, and `<limit lower / upper>` of `{}`.",
+                    gripper.joint
+                ),
+            );
+            wl(
+                w,
+                &format!(
+                    "            gripper: Some(Gripper {{ default: {}, lower: {}, upper: {} }}),",
+                    lit(FINGER_OPENING),
+                    lit(lower),
+                    lit(upper)
+                ),
+            );
+        }
+        None => wl(w, "            gripper: None,"),
+    }
     wl(w, "        }");
     wl(w, "    };");
     wl(w, "}");

@@ -1,9 +1,11 @@
-//! Build-time generator of edmp-rs: freezes the Panda kinematic chain and the trained,
-//! int8-quantized diffusion network into Rust tables that `edmp-core` includes from `OUT_DIR`.
+//! Build-time generator of edmp-rs: freezes each arm's kinematic chain ([`arms::ARMS`]) and the
+//! trained, int8-quantized diffusion network into Rust tables that `edmp-core` includes from
+//! `OUT_DIR`.
 //!
 //! `edmp-core/build.rs` calls [`generate_robot`] and [`prior::generate_prior`]; the `edmp-codegen` binary prints the same
 //! output for review. Nothing here runs on the target.
 
+pub mod arms;
 pub mod emit;
 pub mod math;
 pub mod mesh;
@@ -21,12 +23,31 @@ pub struct Generated {
     pub inputs: Vec<PathBuf>,
 }
 
-/// Reads `urdf` (and its collision meshes) and returns the robot tables. `display` is the
-/// name the generated comments give the URDF (a stable, repository-relative path).
-pub fn generate_robot(urdf: &Path, display: &str) -> Result<Generated, String> {
-    let chain = urdf::read_chain(urdf)?;
-    Ok(Generated {
-        source: emit::robot_tables(&chain, display),
-        inputs: chain.inputs,
+/// Generated robot tables and the sizes a build needs to hold them.
+#[derive(Clone, Debug)]
+pub struct GeneratedArm {
+    /// The source and its inputs.
+    pub generated: Generated,
+    /// Link frames.
+    pub frames: usize,
+    /// Collision bodies.
+    pub bodies: usize,
+    /// Actuated joints.
+    pub joints: usize,
+}
+
+/// Reads the URDF at `urdf` (arm `arm`'s, or an edited copy) with its collision meshes and
+/// returns its tables. The generated comments name the URDF by `arm.urdf`, its
+/// repository-relative path.
+pub fn generate_robot(urdf: &Path, arm: &arms::ArmSpec) -> Result<GeneratedArm, String> {
+    let chain = urdf::read_chain(urdf, arm)?;
+    Ok(GeneratedArm {
+        frames: chain.frames.len(),
+        bodies: chain.bodies.len(),
+        joints: chain.joints.len(),
+        generated: Generated {
+            source: emit::robot_tables(&chain, arm.urdf),
+            inputs: chain.inputs,
+        },
     })
 }

@@ -1,17 +1,20 @@
 //! Prints the Rust tables that `edmp-core`'s build script generates, for review.
 //!
-//! Usage: `edmp-codegen [URDF]` (default: `weights/panda/panda.urdf`).
+//! Usage: `edmp-codegen [ARM]` (default `panda`; see `arms::ARMS`), run from the repository root.
 
-use std::path::PathBuf;
+use std::path::Path;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let urdf = std::env::args()
-        .nth(1)
-        .map_or_else(|| PathBuf::from("weights/panda/panda.urdf"), PathBuf::from);
-    match edmp_codegen::generate_robot(&urdf, &urdf.display().to_string()) {
+    let name = std::env::args().nth(1).unwrap_or_else(|| "panda".to_owned());
+    let Some(arm) = edmp_codegen::arms::arm(&name) else {
+        let known: Vec<_> = edmp_codegen::arms::ARMS.iter().map(|a| a.name).collect();
+        eprintln!("edmp-codegen: no arm `{name}` (known: {})", known.join(", "));
+        return ExitCode::from(2);
+    };
+    match edmp_codegen::generate_robot(Path::new(arm.urdf), arm) {
         Ok(generated) => {
-            print!("{}", generated.source);
+            print!("{}", generated.generated.source);
             ExitCode::SUCCESS
         }
         Err(e) => {

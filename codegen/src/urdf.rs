@@ -1,6 +1,8 @@
-//! The kinematic chain read from the URDF: frames in parent-before-child order, the actuated
-//! joints with both limit sets, and one collision body per link that has a collision mesh.
+//! The kinematic chain read from an arm's URDF: frames in parent-before-child order, the
+//! actuated joints with both limit sets, one collision body per link that has a collision
+//! mesh, and the self-collision pairs by the arm's rule.
 
+use crate::arms::{ArmSpec, LimitSource, PairRule};
 use crate::math::{self, Mat3, Vec3};
 use crate::mesh::{self, OrientedBox};
 use std::path::{Path, PathBuf};
@@ -9,10 +11,6 @@ use std::path::{Path, PathBuf};
 /// docs/formats.md makes the value of an absent `gripper` field. The opening itself is
 /// an input (the scene's `gripper.finger`), not folded into the tables.
 pub const FINGER_OPENING: f64 = 0.025;
-/// The URDF link that is the tool centre point (docs/formats.md).
-pub const TCP_LINK: &str = "panda_grasptarget";
-/// The URDF link that a held object is attached to (docs/formats.md).
-pub const HAND_LINK: &str = "panda_hand";
 
 /// How a frame moves relative to its parent.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,7 +60,8 @@ pub struct JointLimits {
     pub name: String,
     /// `<limit lower upper>`: the hardware range.
     pub hard: [f64; 2],
-    /// `<safety_controller soft_lower_limit soft_upper_limit>`: Franka's official range, used for planning.
+    /// The planning range: `<safety_controller soft_lower_limit soft_upper_limit>` (Franka's
+    /// official range) or `<limit>` again, as the arm's [`LimitSource`] says.
     pub soft: [f64; 2],
 }
 
@@ -86,9 +85,20 @@ pub struct Body {
     pub points: Vec<Vec3>,
 }
 
+/// The gripper: one driving prismatic joint whose value is the opening.
+#[derive(Clone, Debug)]
+pub struct Gripper {
+    /// The driving finger joint (the one the others `<mimic>`).
+    pub joint: String,
+    /// Its `<limit lower upper>`: the range of the opening.
+    pub limits: [f64; 2],
+}
+
 /// Everything the generator knows of the robot.
 #[derive(Clone, Debug)]
 pub struct Chain {
+    /// The arm this chain was read for.
+    pub arm: ArmSpec,
     /// Frames, parents first.
     pub frames: Vec<Frame>,
     /// Actuated joints, in chain order.
@@ -97,18 +107,18 @@ pub struct Chain {
     pub bodies: Vec<Body>,
     /// Index of the TCP frame.
     pub tcp: usize,
-    /// Index of the hand frame.
+    /// Index of the frame a held object attaches to.
     pub hand: usize,
-    /// The driving finger joint (the one the others `<mimic>`): its value is the opening.
-    pub finger_joint: String,
-    /// `<limit lower upper>` of the driving finger joint: the range of the opening.
-    pub finger_limits: [f64; 2],
+    /// The gripper, for arms with one.
+    pub gripper: Option<Gripper>,
+    /// Body index pairs `(a, b)`, `a < b`, checked against each other, by the arm's rule.
+    pub self_pairs: Vec<(usize, usize)>,
     /// Every file that was read (for `cargo:rerun-if-changed`).
     pub inputs: Vec<PathBuf>,
 }
 
-/// Reads the URDF at `path` and the collision meshes it names.
-pub fn read_chain(path: &Path) -> Result<Chain, String> {
+/// Reads the URDF at `path` and the collision meshes it names, for the arm `arm`.
+pub fn read_chain(path: &Path, arm: &ArmSpec) -> Result<Chain, String> {
     let robot = urdf_rs::read_file(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let root_dir = path.parent().unwrap_or(Path::new("."));
     let mut inputs = vec![path.to_path_buf()];
@@ -144,14 +154,21 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
             let (motion, provenance) = match joint.joint_type {
                 urdf_rs::JointType::Revolute => {
                     let axis = normalised(&joint.axis.xyz, &joint.name)?;
-                    let safety = joint
-                        .safety_controller
-                        .as_ref()
-                        .ok_or(format!("joint `{}` has no <safety_controller> soft limits", joint.name))?;
+                    let hard = [joint.limit.lower, joint.limit.upper];
+                    let soft = match arm.limits {
+                        LimitSource::Limit => hard,
+                        LimitSource::SafetyController => {
+                            let safety = joint
+                                .safety_controller
+                                .as_ref()
+                                .ok_or(format!("joint `{}` has no <safety_controller> soft limits", joint.name))?;
+                            [safety.soft_lower_limit, safety.soft_upper_limit]
+                        }
+                    };
                     joints.push(JointLimits {
                         name: joint.name.clone(),
-                        hard: [joint.limit.lower, joint.limit.upper],
-                        soft: [safety.soft_lower_limit, safety.soft_upper_limit],
+                        hard,
+                        soft,
                     });
                     let motion = Motion::Revolute {
                         joint: joints.len() - 1,
@@ -224,8 +241,12 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
     }
 
     // One opening for the whole gripper: one driving finger joint, every other one mimics it.
-    let (finger_joint, finger_limits) = match fingers.as_slice() {
+    let gripper = match fingers.as_slice() {
+        [] if !arm.gripper => None,
         [] => return Err("no prismatic finger joint: the gripper opening has nothing to drive".to_owned()),
+        [(name, _)] if !arm.gripper => {
+            return Err(format!("prismatic `{name}`: arm `{}` has no gripper", arm.name));
+        }
         [(name, limits)] => {
             if let Some((follower, driver)) = drivers.iter().find(|(_, d)| d != name) {
                 return Err(format!(
@@ -235,7 +256,15 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
             if !(limits[0].is_finite() && limits[1].is_finite() && limits[0] <= limits[1]) {
                 return Err(format!("prismatic `{name}`: limits {limits:?} are not a range"));
             }
-            (name.clone(), *limits)
+            if !(limits[0] <= FINGER_OPENING && FINGER_OPENING <= limits[1]) {
+                return Err(format!(
+                    "the default finger opening {FINGER_OPENING} m is outside the URDF's limits {limits:?}"
+                ));
+            }
+            Some(Gripper {
+                joint: name.clone(),
+                limits: *limits,
+            })
         }
         more => {
             let names: Vec<_> = more.iter().map(|(n, _)| n.as_str()).collect();
@@ -244,11 +273,6 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
             ));
         }
     };
-    if !(finger_limits[0] <= FINGER_OPENING && FINGER_OPENING <= finger_limits[1]) {
-        return Err(format!(
-            "the default finger opening {FINGER_OPENING} m is outside the URDF's limits {finger_limits:?}"
-        ));
-    }
 
     let mut bodies = Vec::new();
     for (index, frame) in frames.iter().enumerate() {
@@ -297,18 +321,58 @@ pub fn read_chain(path: &Path) -> Result<Chain, String> {
             .position(|f| f.name == name)
             .ok_or(format!("no link `{name}`"))
     };
-    let tcp = find(TCP_LINK)?;
-    let hand = find(HAND_LINK)?;
+    let tcp = find(arm.tcp_link)?;
+    let hand = find(arm.hand_link)?;
+    let self_pairs = match arm.pairs {
+        PairRule::Levels => level_pairs(&frames, &bodies),
+        PairRule::ApartAtZero => {
+            return Err(format!(
+                "arm `{}`: the apart-at-zero pair rule is not built yet",
+                arm.name
+            ));
+        }
+    };
     Ok(Chain {
+        arm: *arm,
         frames,
         joints,
         bodies,
         tcp,
         hand,
-        finger_joint,
-        finger_limits,
+        gripper,
+        self_pairs,
         inputs,
     })
+}
+
+/// How many revolute joints lie between `frame` and the root.
+pub fn level(frames: &[Frame], frame: usize) -> usize {
+    let mut f = frame;
+    let mut joints = 0;
+    for _ in 0..frames.len() {
+        if matches!(frames[f].motion, Motion::Revolute { .. }) {
+            joints += 1;
+        }
+        if f == 0 {
+            break;
+        }
+        f = frames[f].parent;
+    }
+    joints
+}
+
+/// The Panda's rule ([`PairRule::Levels`]): bodies two or more revolute joints apart.
+fn level_pairs(frames: &[Frame], bodies: &[Body]) -> Vec<(usize, usize)> {
+    let levels: Vec<_> = bodies.iter().map(|b| level(frames, b.frame)).collect();
+    let mut pairs = Vec::new();
+    for a in 0..bodies.len() {
+        for b in a + 1..bodies.len() {
+            if levels[a].abs_diff(levels[b]) >= 2 {
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
 }
 
 fn normalised(v: &Vec3, joint: &str) -> Result<Vec3, String> {

@@ -1,10 +1,15 @@
 //! The generator on the committed Panda URDF: boxes hold their meshes, and the URDF drives
 //! the output (a changed origin changes the generated tables).
 
+use edmp_codegen::arms::ArmSpec;
 use edmp_codegen::math;
 use edmp_codegen::mesh::read_obj_vertices;
 use edmp_codegen::urdf::read_chain;
 use std::path::{Path, PathBuf};
+
+fn panda() -> &'static ArmSpec {
+    edmp_codegen::arms::arm("panda").unwrap()
+}
 
 fn panda_urdf() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../weights/panda/panda.urdf")
@@ -12,7 +17,7 @@ fn panda_urdf() -> PathBuf {
 
 #[test]
 fn every_box_holds_every_vertex_and_beats_the_aabb() {
-    let chain = read_chain(&panda_urdf()).expect("the committed URDF reads");
+    let chain = read_chain(&panda_urdf(), panda()).expect("the committed URDF reads");
     assert_eq!(chain.joints.len(), 7);
     assert_eq!(chain.bodies.len(), 11, "link0-7, hand and two fingers");
     for body in &chain.bodies {
@@ -45,7 +50,7 @@ fn every_box_holds_every_vertex_and_beats_the_aabb() {
 
 #[test]
 fn mirrored_fingers_get_equal_boxes() {
-    let chain = read_chain(&panda_urdf()).unwrap();
+    let chain = read_chain(&panda_urdf(), panda()).unwrap();
     let volume = |name: &str| chain.bodies.iter().find(|b| b.name == name).unwrap().tight.volume();
     let (left, right) = (volume("panda_leftfinger"), volume("panda_rightfinger"));
     assert!((left - right).abs() < 1e-3 * left, "{left} vs {right}");
@@ -63,11 +68,13 @@ fn changing_the_urdf_changes_the_tables() {
     let edited = original.replacen(r#"xyz="0 0 0.333""#, r#"xyz="0 0 0.343""#, 1);
     assert_ne!(edited, original, "the test's edit must apply");
     std::fs::write(dir.join("panda.urdf"), &edited).unwrap();
-    let before = edmp_codegen::generate_robot(&panda_urdf(), "panda.urdf")
+    let before = edmp_codegen::generate_robot(&panda_urdf(), panda())
         .unwrap()
+        .generated
         .source;
-    let after = edmp_codegen::generate_robot(&dir.join("panda.urdf"), "panda.urdf")
+    let after = edmp_codegen::generate_robot(&dir.join("panda.urdf"), panda())
         .unwrap()
+        .generated
         .source;
     std::fs::remove_dir_all(&dir).ok();
     assert_ne!(before, after);
@@ -83,7 +90,7 @@ fn malformed_urdf_is_a_clear_error() {
         "<robot name=\"x\"><link name=\"a\"/><link name=\"b\"/></robot>",
     )
     .unwrap();
-    let err = edmp_codegen::generate_robot(&dir.join("bad.urdf"), "bad.urdf").unwrap_err();
+    let err = edmp_codegen::generate_robot(&dir.join("bad.urdf"), panda()).unwrap_err();
     std::fs::remove_dir_all(&dir).ok();
     assert!(err.contains("root link"), "{err}");
 }

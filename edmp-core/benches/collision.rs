@@ -12,8 +12,8 @@ use edmp_core::executor::Serial;
 use edmp_core::guidance::guides::EDMP_GUIDES;
 use edmp_core::guidance::{GuideStep, StepRule, guide_step_on};
 use edmp_core::rng::Rng;
-use edmp_core::robot::HAND_FRAME;
 use edmp_core::robot::kinematics::forward;
+use edmp_core::robot::{HAND_FRAME, PANDA};
 use edmp_core::scene::{Obstacle, Scene};
 
 const H: usize = 50;
@@ -109,7 +109,7 @@ fn bench(c: &mut Criterion) {
     // at its middle waypoint (as after denoising, when most of a candidate is free); in the
     // 20-obstacle scene above most segments of most rows touch something.
     let mut cube = Scene::<64>::new();
-    let hand = forward(&batch[0][H / 2]).unwrap().frames[HAND_FRAME].translation;
+    let hand = forward(&PANDA, &batch[0][H / 2]).unwrap().frames[HAND_FRAME].translation;
     cube.push(Obstacle::cuboid(hand.into(), [0.12; 3], [1.0, 0.0, 0.0, 0.0]).unwrap())
         .unwrap();
     let first = [batch[0]; BATCH];

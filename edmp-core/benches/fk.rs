@@ -42,19 +42,21 @@ fn bench(c: &mut Criterion) {
     let g = gradient();
     let mut group = c.benchmark_group("kinematics");
     group.throughput(Throughput::Elements(1));
-    group.bench_function("fk/1", |b| b.iter(|| forward(black_box(&qs[0]))));
+    group.bench_function("fk/1", |b| {
+        b.iter(|| forward(&edmp_core::robot::PANDA, black_box(&qs[0])))
+    });
     group.bench_function("fk+corners/1", |b| {
-        b.iter(|| forward(black_box(&qs[0])).map(|k| k.all_corners()))
+        b.iter(|| forward(&edmp_core::robot::PANDA, black_box(&qs[0])).map(|k| k.all_corners()))
     });
     group.bench_function("fk+adjoint/1", |b| {
-        b.iter(|| forward(black_box(&qs[0])).and_then(|k| k.adjoint(black_box(&g))))
+        b.iter(|| forward(&edmp_core::robot::PANDA, black_box(&qs[0])).and_then(|k| k.adjoint(black_box(&g))))
     });
     group.throughput(Throughput::Elements(qs.len() as u64));
     group.bench_function("fk+adjoint/600 (12 trajectories x 50 waypoints)", |b| {
         b.iter(|| {
             let mut acc = [0.0f32; JOINTS];
             for q in black_box(&qs) {
-                if let Ok(dq) = forward(q).and_then(|k| k.adjoint(&g)) {
+                if let Ok(dq) = forward(&edmp_core::robot::PANDA, q).and_then(|k| k.adjoint(&g)) {
                     for (a, d) in acc.iter_mut().zip(dq) {
                         *a += d;
                     }
@@ -65,7 +67,11 @@ fn bench(c: &mut Criterion) {
     });
     // Inverse kinematics of reachable TCP poses (FK of the first 100 configurations), from the
     // ready pose: the time of one solve, averaged over the 100.
-    let targets: Vec<_> = qs.iter().take(100).map(|q| *forward(q).unwrap().tcp()).collect();
+    let targets: Vec<_> = qs
+        .iter()
+        .take(100)
+        .map(|q| *forward(&edmp_core::robot::PANDA, q).unwrap().tcp())
+        .collect();
     let ready = [0.0f32, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
     let scene = Scene::<1>::new();
     group.throughput(Throughput::Elements(targets.len() as u64));

@@ -1,14 +1,14 @@
 //! The planning core of edmp-rs: `no_std`, no allocation, deterministic.
 //!
-//! This crate holds the math a controller embeds: the Panda's kinematics (frozen from its
-//! URDF at build time), and, as the project grows, the collision costs, the checker, the
-//! diffusion prior and the guided planner. Everything runs on fixed-size arrays; bad input
+//! This crate holds the math a controller embeds: each compiled-in arm's kinematics (frozen
+//! from its URDF at build time, one cargo feature per arm), the collision costs, the checker,
+//! the diffusion prior and the guided planner. Everything runs on fixed-size arrays; bad input
 //! is a typed [`Error`], never a panic or a NaN.
 //!
 //! ```
-//! use edmp_core::robot::kinematics::forward;
+//! use edmp_core::robot::{PANDA, kinematics::forward};
 //! let ready = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-//! let k = forward::<f32>(&ready).unwrap();
+//! let k = forward(&PANDA, &ready).unwrap();
 //! let tcp = k.tcp().translation;
 //! assert!(tcp.x > 0.2 && tcp.z > 0.2);
 //! ```

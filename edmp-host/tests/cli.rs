@@ -441,7 +441,9 @@ fn every_example_plans_a_collision_free_path_from_its_start_to_its_goal() {
         } else {
             pose_goals += 1;
             let pose = &doc["goal"]["pose"];
-            let tcp = *edmp_core::robot::kinematics::forward::<f32>(&last).unwrap().tcp();
+            let tcp = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &last)
+                .unwrap()
+                .tcp();
             let p = &pose["position"];
             let error: f32 = (0..3)
                 .map(|i| (tcp.translation[i] - p[i].as_f64().unwrap() as f32).powi(2))
@@ -648,7 +650,7 @@ fn filter_robot_drops_the_robots_own_points_and_the_plan_counts_them() {
         .iter()
         .map(|x| x.as_f64().unwrap() as f32)
         .collect();
-    let k = forward_with(&<[f32; 7]>::try_from(start).unwrap(), 0.025).unwrap();
+    let k = forward_with(&edmp_core::robot::PANDA, &<[f32; 7]>::try_from(start).unwrap(), 0.025).unwrap();
     let hand = k.frames[HAND_FRAME].translation;
     // Two points on the hand (a camera saw the robot) and one far away.
     let cloud = serde_json::json!({"type": "points", "radius": 0.005,

@@ -133,7 +133,7 @@ fn a_hand_pose_goal_becomes_the_tcp_pose() {
         1e-6
     ));
     let goal = joint_goal(&problem).unwrap();
-    let tcp = *forward(&goal).unwrap().tcp();
+    let tcp = *forward(&edmp_core::robot::PANDA, &goal).unwrap().tcp();
     let want = [0.48748365f32, -0.3335055, 0.25502735];
     for (x, y) in tcp.translation.iter().zip(want) {
         assert!((x - y).abs() < 1e-3, "IK's TCP {:?}", tcp.translation);

@@ -294,7 +294,7 @@ fn chromium_draws_the_arm_where_the_kinematics_put_it() {
     );
     let finger = problem.scene().gripper();
     let fk_tcp = |i: usize| {
-        forward_with(&plan.waypoints[i], finger)
+        forward_with(&edmp_core::robot::PANDA, &plan.waypoints[i], finger)
             .unwrap()
             .tcp()
             .translation

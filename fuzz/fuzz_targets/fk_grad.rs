@@ -7,7 +7,7 @@
 
 use edmp_core::Error;
 use edmp_core::robot::kinematics::forward;
-use edmp_core::robot::JOINTS;
+use edmp_core::robot::{JOINTS, PANDA};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -25,7 +25,7 @@ fuzz_target!(|data: &[u8]| {
         }
     }
 
-    let k = match forward(&q) {
+    let k = match forward(&PANDA, &q) {
         Ok(k) => k,
         Err(Error::NonFiniteJoint { joint }) => {
             assert!(!q[joint as usize].is_finite());

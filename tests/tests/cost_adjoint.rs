@@ -65,7 +65,7 @@ fn case() -> impl Strategy<Value = Case> {
                 // Obstacles sit on the robot: centred near a body corner at a waypoint.
                 let mut scene = Scene::<16>::new().with_gripper(finger).unwrap();
                 for (i, (shape, body, corner, offset, size, quat)) in obstacles.into_iter().enumerate() {
-                    let k = forward_with(&trajectory[i % H], finger).unwrap();
+                    let k = forward_with(&edmp_core::robot::PANDA, &trajectory[i % H], finger).unwrap();
                     let c = k.corners(body)[corner];
                     let center = [c.x + offset[0], c.y + offset[1], c.z + offset[2]];
                     let n = quat.iter().map(|v| v * v).sum::<f32>().sqrt().max(1e-3);
@@ -205,7 +205,7 @@ proptest! {
 #[test]
 fn the_gradient_at_a_non_default_opening_matches_finite_differences() {
     let q = [0.1f32, -0.6, 0.05, -2.2, 0.02, 1.7, 0.6];
-    let k = forward(&q).unwrap();
+    let k = forward(&edmp_core::robot::PANDA, &q).unwrap();
     let hand = &k.frames[edmp_core::robot::HAND_FRAME];
     let center = hand.transform_point(&nalgebra::Vector3::new(0.0, 0.0, 0.095));
     let trajectory: [[f32; JOINTS]; H] = core::array::from_fn(|w| {
@@ -285,7 +285,7 @@ fn original_cylinder_boxing_under_covers() {
     // The switch reproduces the original's (r, r, h) box: a quarter of the footprint.
     let mut scene = Scene::<16>::new();
     let q = [0.0f32, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-    let hand = forward(&q).unwrap().frames[edmp_core::robot::HAND_FRAME].translation;
+    let hand = forward(&edmp_core::robot::PANDA, &q).unwrap().frames[edmp_core::robot::HAND_FRAME].translation;
     scene
         .push(Obstacle::cylinder(hand.into(), 0.3, 0.3, [1.0, 0.0, 0.0, 0.0]).unwrap())
         .unwrap();

@@ -54,7 +54,7 @@ proptest! {
     #[test]
     fn f64_adjoint_matches_tightly(q in joints_within_soft_limits(), g in corner_gradient()) {
         let q64 = q.map(f64::from);
-        let k = forward(&q64).unwrap();
+        let k = forward(&edmp_core::robot::PANDA_F64, &q64).unwrap();
         let g64 = g.map(|b| b.map(|v| v.cast::<f64>()));
         let adjoint = k.adjoint(&g64).unwrap();
         let fd = finite_difference(&q64, &g, 1e-6);
@@ -68,7 +68,7 @@ proptest! {
     /// position rows from `∂L/∂p = e_r`, orientation rows from `∂L/∂R = ½[e_r]×R`.
     #[test]
     fn tcp_jacobian_matches_adjoint(q in joints_within_soft_limits()) {
-        let k = forward(&q).unwrap();
+        let k = forward(&edmp_core::robot::PANDA, &q).unwrap();
         let jac = k.tcp_jacobian();
         let rot = k.tcp().rotation;
         for r in 0..6 {
@@ -94,7 +94,7 @@ fn a_wrong_adjoint_would_be_caught() {
     let q = [0.3f32, -0.5, 0.2, -2.0, 0.1, 1.8, 0.7];
     let mut g = zero_gradient();
     g[7][3] = Vector3::new(0.4, -0.2, 0.9);
-    let k = forward(&q).unwrap();
+    let k = forward(&edmp_core::robot::PANDA, &q).unwrap();
     let mut adjoint = k.adjoint(&g).unwrap();
     let fd = finite_difference(&q.map(f64::from), &g, 1e-6);
     let tol = edmp_tests::ADJOINT_REL_TOL * gradient_scale(&g);

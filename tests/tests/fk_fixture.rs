@@ -30,7 +30,7 @@ fn fk_matches_pybullet_for_every_recorded_configuration() {
     let (mut worst_pos, mut worst_rot) = (0.0f64, 0.0f64);
     for (n, sample) in fixture.samples.iter().enumerate() {
         let q = sample.joints.map(|x| x as f32);
-        let k = forward(&q).expect("finite joints");
+        let k = forward(&edmp_core::robot::PANDA, &q).expect("finite joints");
         assert_eq!(sample.poses.len(), FRAMES);
         for (f, pose) in sample.poses.iter().enumerate() {
             let expected_pos = Vector3::new(pose[0], pose[1], pose[2]);
@@ -64,7 +64,7 @@ fn f64_fk_matches_pybullet_to_recording_precision() {
     let fixture = fk_fixture();
     let mut worst = 0.0f64;
     for sample in &fixture.samples {
-        let k = forward(&sample.joints).expect("finite joints");
+        let k = forward(&edmp_core::robot::PANDA_F64, &sample.joints).expect("finite joints");
         for (f, pose) in sample.poses.iter().enumerate() {
             let err = (k.frames[f].translation - Vector3::new(pose[0], pose[1], pose[2])).norm();
             assert!(err < 2e-7, "{}: {err:e}", FRAME_NAMES[f]);

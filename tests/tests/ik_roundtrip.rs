@@ -24,11 +24,11 @@ fn ik_round_trip_on_1000_reachable_poses() {
             continue; // not a valid robot state, so its pose is not a fair target
         }
         tried += 1;
-        let target = *forward(&q).unwrap().tcp();
+        let target = *forward(&edmp_core::robot::PANDA, &q).unwrap().tcp();
         let Ok(s) = solve(&target, &ready, &scene, &IkConfig::default()) else {
             continue;
         };
-        let tcp = *forward(&s.joints).unwrap().tcp();
+        let tcp = *forward(&edmp_core::robot::PANDA, &s.joints).unwrap().tcp();
         let dp = (tcp.translation - target.translation).norm();
         let dr = rotation_error(&target.rotation, &tcp.rotation).norm();
         assert!(

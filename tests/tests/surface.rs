@@ -29,7 +29,7 @@ fn configuration() -> impl Strategy<Value = [f32; 7]> {
 /// Body `b`'s hull and the point `gap` beyond it along `d` (unit), with the exact distance
 /// from that point to the hull (`gap`) and the foot on the hull.
 fn beyond(q: &[f32; 7], b: usize, d: Vector3<f32>, gap: f32) -> (Vector3<f32>, Vector3<f32>) {
-    let k = forward_with(q, 0.025).unwrap();
+    let k = forward_with(&edmp_core::robot::PANDA, q, 0.025).unwrap();
     let hull = Hull {
         pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
         points: PANDA.hull(b),
@@ -40,7 +40,7 @@ fn beyond(q: &[f32; 7], b: usize, d: Vector3<f32>, gap: f32) -> (Vector3<f32>, V
 
 /// The distance from `p` to the nearest moving body other than `b` (GJK's lower bound).
 fn nearest_other(q: &[f32; 7], b: usize, p: &Element) -> f32 {
-    let k = forward_with(q, 0.025).unwrap();
+    let k = forward_with(&edmp_core::robot::PANDA, q, 0.025).unwrap();
     (0..BODIES)
         .filter(|&o| o != b && PANDA.bodies[o].frame != 0)
         .map(|o| {

@@ -184,7 +184,7 @@ const PLACEHOLDER: Solid = Solid {
 
 /// One state's shapes, placed.
 struct Placed<'a> {
-    k: &'a Kinematics<f32>,
+    k: &'a Kinematics<f32, JOINTS>,
     held: Option<Solid>,
     /// Obstacle clearance for this state.
     margin: f32,
@@ -439,7 +439,7 @@ impl<'s, const N: usize> Prepared<'s, N> {
         if !untested {
             return Ok(None);
         }
-        let k = forward_with(q, self.scene.gripper())?;
+        let k = forward_with(&PANDA, q, self.scene.gripper())?;
         let self_margin = self.config.self_margin;
         let carry = self.config.margin.max(self.config.end_margin) + CARRY_SLACK;
         let carry_self = self_margin + CARRY_SLACK;
@@ -567,7 +567,7 @@ pub fn check_end<const N: usize>(
 /// object) to the nearest obstacle or surface piece: zero when something may touch. Self-contact is not counted; for
 /// diagnostics and for choosing among states that are all free.
 pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f32, Error> {
-    let k = forward_with(q, scene.gripper())?;
+    let k = forward_with(&PANDA, q, scene.gripper())?;
     let held = scene.held().map(|h| Solid::attached(h, &k.frames[HAND_FRAME]));
     let mut best = f32::INFINITY;
     for o in scene.obstacles().iter().map(Solid::obstacle) {
@@ -806,7 +806,7 @@ mod tests {
     /// A thin plate between the fingers (2 cm across the hand's y, 1 cm thick, 2 cm tall, centred
     /// 9.5 cm from the hand on its z, turned with the hand), as one obstacle.
     fn plate_between_the_fingers() -> Scene<'static, 4> {
-        let k = forward(&READY).unwrap();
+        let k = forward(&crate::robot::PANDA, &READY).unwrap();
         let hand = &k.frames[HAND_FRAME];
         let center = hand.transform_point(&Vector3::new(0.0, 0.0, 0.095));
         let mut scene = Scene::<4>::new();
@@ -849,7 +849,7 @@ mod tests {
     #[test]
     #[cfg_attr(miri, ignore = "the exact checker at many states: hours under Miri")]
     fn a_box_on_the_hand_is_contact_and_far_away_is_free() {
-        let k = forward(&READY).unwrap();
+        let k = forward(&crate::robot::PANDA, &READY).unwrap();
         let hand = k.frames[HAND_FRAME].translation;
         let mut scene = Scene::<4>::new();
         scene
@@ -1031,7 +1031,7 @@ mod tests {
     #[cfg_attr(miri, ignore = "the exact checker at many states: hours under Miri")]
     fn the_held_object_counts_against_obstacles() {
         // A 30 cm rod held along the hand's z: an obstacle at its far end touches only the rod.
-        let k = forward(&READY).unwrap();
+        let k = forward(&crate::robot::PANDA, &READY).unwrap();
         let hand = &k.frames[HAND_FRAME];
         let tip = hand.transform_point(&Vector3::new(0.0, 0.0, 0.38));
         let mut scene = Scene::<4>::new();

@@ -24,7 +24,7 @@ pub fn filter_robot(points: &mut [[f32; 3]], q: &Joints<f32>, finger: f32, dista
     if !(distance.is_finite() && distance >= 0.0) {
         return Err(Error::BadParameter);
     }
-    let k = forward_with(q, finger)?;
+    let k = forward_with(&PANDA, q, finger)?;
     let bodies: [(Vector3<f32>, f32); BODIES] = core::array::from_fn(|b| {
         let body = &PANDA.bodies[b];
         (
@@ -63,7 +63,7 @@ mod tests {
     #[test]
     fn the_robots_own_points_are_dropped() {
         let ready = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-        let k = forward_with(&ready, 0.025).unwrap();
+        let k = forward_with(&crate::robot::PANDA, &ready, 0.025).unwrap();
         let tcp = k.tcp().translation;
         // One point at the hand's origin (on the robot), one 1 m away.
         let hand = k.frames[crate::robot::HAND_FRAME].translation;

@@ -78,9 +78,9 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     }
     let mut total = 0.0f32;
     // Waypoint w − 1 and w in flight, each with the cotangent its segments gather.
-    let mut before: Option<(Kinematics<f32>, Cotangent<f32>, bool)> = None;
+    let mut before: Option<(Kinematics<f32, JOINTS>, Cotangent<f32>, bool)> = None;
     for (w, q) in trajectory.iter().enumerate() {
-        let k = forward_with(q, scene.gripper())?;
+        let k = forward_with(&PANDA, q, scene.gripper())?;
         let mut current = (k, Cotangent::new(), false);
         if let Some((kb, cot_b, touched_b)) = before.as_mut() {
             let (kc, cot_c, touched_c) = (&current.0, &mut current.1, &mut current.2);
@@ -175,7 +175,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
 fn write_gradient<const H: usize>(
     gradient: Option<&mut [Joints<f32>; H]>,
     w: usize,
-    k: &Kinematics<f32>,
+    k: &Kinematics<f32, JOINTS>,
     cot: &Cotangent<f32>,
     touched: bool,
 ) -> Result<(), Error> {
@@ -334,7 +334,7 @@ mod tests {
                 let t = w as f32 / (H - 1) as f32;
                 core::array::from_fn(|j| a[j] + t * (b[j] - a[j]))
             });
-            let k = forward_with(&x[H / 2], 0.025).unwrap();
+            let k = forward_with(&crate::robot::PANDA, &x[H / 2], 0.025).unwrap();
             let near = k.boxes[(u(1.0, BODIES as f32) as usize).min(BODIES - 1)].translation;
             let mut scene = Scene::<4>::new();
             let center = [near.x + u(-0.1, 0.1), near.y + u(-0.1, 0.1), near.z + u(-0.1, 0.1)];

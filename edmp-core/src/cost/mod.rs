@@ -24,7 +24,7 @@ pub mod cover;
 use crate::cost::boxes::{Aabb, BoxFrame, CylinderBox, Inflation, box_dims, inflated_dims, obstacle_aabb};
 use crate::error::Error;
 use crate::robot::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward_into};
-use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
+use crate::robot::{BODIES, HAND_FRAME, JOINTS, MAX_BODIES, MAX_FRAMES, PANDA};
 use crate::scene::{Obstacle, Scene};
 use nalgebra::{Matrix3, Vector3};
 
@@ -226,7 +226,7 @@ fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector
 /// few kilobytes and the costs' inner loop must not copy it.
 #[derive(Clone, Copy, Debug)]
 struct Waypoint {
-    k: Kinematics<f32>,
+    k: Kinematics<f32, JOINTS>,
     boxes: [RobotBox; SLOTS],
     /// Per box, a world AABB holding its AABB in any frame, and their union (broad phase).
     balls: SlotBoxes,
@@ -253,8 +253,9 @@ const NO_BOX: Aabb = Aabb {
 impl Waypoint {
     const EMPTY: Self = Self {
         k: Kinematics {
-            frames: [IDLE.pose; FRAMES],
-            boxes: [IDLE.pose; BODIES],
+            robot: &PANDA,
+            frames: [IDLE.pose; MAX_FRAMES],
+            boxes: [IDLE.pose; MAX_BODIES],
         },
         boxes: [IDLE; SLOTS],
         balls: SlotBoxes::EMPTY,
@@ -766,7 +767,7 @@ mod tests {
     #[test]
     #[cfg_attr(miri, ignore = "costs and gradient of a whole trajectory: too slow")]
     fn a_box_around_the_hand_costs_and_pulls() {
-        let k = forward(&READY).unwrap();
+        let k = forward(&crate::robot::PANDA, &READY).unwrap();
         let hand = k.frames[HAND_FRAME].translation;
         let mut scene = Scene::<4>::new();
         scene
@@ -790,7 +791,7 @@ mod tests {
     #[cfg_attr(miri, ignore = "costs and gradient of a whole trajectory: too slow")]
     fn the_finger_boxes_follow_the_scenes_opening() {
         // A plate between the fingers: the finger boxes overlap it only when closed.
-        let k = forward(&READY).unwrap();
+        let k = forward(&crate::robot::PANDA, &READY).unwrap();
         let hand = &k.frames[HAND_FRAME];
         let center = hand.transform_point(&Vector3::new(0.0, 0.0, 0.095));
         let mut scene = Scene::<4>::new();

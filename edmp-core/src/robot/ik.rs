@@ -161,7 +161,7 @@ fn valid_target(target: &Pose<f32>) -> bool {
 /// One damped-least-squares descent from `q`; the converged configuration and its errors.
 fn descend(target: &Pose<f32>, mut q: Joints<f32>, config: &IkConfig) -> Result<Option<IkSolution>, Error> {
     for _ in 0..config.iterations {
-        let k = forward(&q)?;
+        let k = forward(&PANDA, &q)?;
         let tcp = k.tcp();
         let dp = target.translation - tcp.translation;
         let dw = rotation_error(&target.rotation, &tcp.rotation);
@@ -271,10 +271,10 @@ mod tests {
     #[cfg_attr(miri, ignore = "IK: up to 6,400 iterations and the checker: too slow")]
     fn finds_the_ready_pose_again() {
         let ready = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-        let target = *forward(&ready).unwrap().tcp();
+        let target = *forward(&PANDA, &ready).unwrap().tcp();
         let preferred = [0.3, -0.5, 0.2, -2.0, 0.1, 1.8, 0.5];
         let s = solve(&target, &preferred, &Scene::<1>::new(), &IkConfig::default()).unwrap();
-        let tcp = *forward(&s.joints).unwrap().tcp();
+        let tcp = *forward(&PANDA, &s.joints).unwrap().tcp();
         assert!((tcp.translation - target.translation).norm() < 1e-3);
         assert!(rotation_error(&target.rotation, &tcp.rotation).norm() < 0.5f32.to_radians());
         assert!(PANDA.within_soft_limits(&s.joints, 0.0));

@@ -1,10 +1,10 @@
-//! Forward kinematics of the Panda, its hand-written adjoint, and frame Jacobians.
+//! Forward kinematics of an arm ([`Robot`]), its hand-written adjoint, and frame Jacobians.
 //!
-//! [`forward`] maps 7 joint angles to the world pose of every link frame and of every
-//! collision box, the fingers at the default opening; [`forward_with`] takes the opening (the
-//! scene's `gripper.finger`, [`crate::scene::Scene::gripper`]) too. The opening moves the
-//! finger frames along their prismatic axes (the hand's ±y) and nothing else: for the adjoint
-//! and the Jacobians it is a constant. [`Kinematics::adjoint`] takes an upstream gradient on box corners back to the
+//! [`forward`] maps the arm's `J` joint angles to the world pose of every link frame and of
+//! every collision box, the fingers (if any) at the default opening; [`forward_with`] takes the
+//! opening (the scene's `gripper.finger`, [`crate::scene::Scene::gripper`]) too. The opening
+//! moves the finger frames along their prismatic axes (the Panda hand's ±y) and nothing else:
+//! for the adjoint and the Jacobians it is a constant. [`Kinematics::adjoint`] takes an upstream gradient on box corners back to the
 //! joints; [`Cotangent`] gathers any other (on points moving with a frame, on frame poses) for
 //! [`Kinematics::joint_gradient`]. Both end in one leaf-to-root sweep:
 //!
@@ -16,7 +16,7 @@
 //! O(frames + corners), with no matrix of partial derivatives ever formed.
 
 use crate::error::Error;
-use crate::robot::{BODIES, FRAMES, JOINTS, Real, TCP_FRAME};
+use crate::robot::{MAX_BODIES, MAX_FRAMES, Real, Robot};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 /// A rigid transform: `world = rotation · local + translation`.
@@ -57,14 +57,16 @@ impl<T: Real> Pose<T> {
     }
 }
 
-/// Joint angles of the 7 actuated joints, radians.
-pub type Joints<T> = [T; JOINTS];
+/// Joint angles of the Panda's 7 actuated joints, radians (the planner's joint vector until it
+/// is generic over the arm).
+pub type Joints<T> = [T; crate::robot::JOINTS];
 
 /// Corner `k` of a box has sign `+` on axis `i` where bit `i` of `k` is set.
 pub const CORNERS: usize = 8;
 
-/// Upstream gradient on the 8 world corners of every collision body.
-pub type CornerGradient<T> = [[Vector3<T>; CORNERS]; BODIES];
+/// Upstream gradient on the 8 world corners of every collision body (bodies past the arm's
+/// count are ignored).
+pub type CornerGradient<T> = [[Vector3<T>; CORNERS]; MAX_BODIES];
 
 /// An upstream gradient, gathered per frame as the force `F = Σ g` and the moment
 /// `M = Σ p×g (+ Σ_j R_j×G_j)` about the world origin that it exerts on that frame; see the
@@ -72,8 +74,8 @@ pub type CornerGradient<T> = [[Vector3<T>; CORNERS]; BODIES];
 /// [`Kinematics::joint_gradient`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cotangent<T: Real> {
-    force: [Vector3<T>; FRAMES],
-    moment: [Vector3<T>; FRAMES],
+    force: [Vector3<T>; MAX_FRAMES],
+    moment: [Vector3<T>; MAX_FRAMES],
     /// Σ x·0 over every input: zero unless some input was NaN or infinite.
     probe: T,
 }
@@ -88,8 +90,8 @@ impl<T: Real> Cotangent<T> {
     /// No gradient yet.
     pub fn new() -> Self {
         Self {
-            force: [Vector3::zeros(); FRAMES],
-            moment: [Vector3::zeros(); FRAMES],
+            force: [Vector3::zeros(); MAX_FRAMES],
+            moment: [Vector3::zeros(); MAX_FRAMES],
             probe: T::zero(),
         }
     }
@@ -134,13 +136,31 @@ impl<T: Real> Cotangent<T> {
     }
 }
 
-/// World poses of every link frame and every collision box for one configuration.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Kinematics<T: Real> {
-    /// World pose of each link frame (see `robot::FRAME_NAMES`).
-    pub frames: [Pose<T>; FRAMES],
-    /// World pose of each collision box (centre and axes; see `robot::BODY_NAMES`).
-    pub boxes: [Pose<T>; BODIES],
+/// World poses of every link frame and every collision box of an arm for one configuration.
+#[derive(Clone, Copy)]
+pub struct Kinematics<T: Real + 'static, const J: usize> {
+    /// The arm.
+    pub robot: &'static Robot<T, J>,
+    /// World pose of each link frame (see [`Robot::frame_names`]); identity past the arm's.
+    pub frames: [Pose<T>; MAX_FRAMES],
+    /// World pose of each collision box (centre and axes; see [`Robot::body_names`]).
+    pub boxes: [Pose<T>; MAX_BODIES],
+}
+
+impl<T: Real, const J: usize> PartialEq for Kinematics<T, J> {
+    fn eq(&self, other: &Self) -> bool {
+        core::ptr::eq(self.robot, other.robot) && self.frames == other.frames && self.boxes == other.boxes
+    }
+}
+
+impl<T: Real, const J: usize> core::fmt::Debug for Kinematics<T, J> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Kinematics")
+            .field("robot", &self.robot.name)
+            .field("frames", &&self.frames[..self.robot.frames.len().min(MAX_FRAMES)])
+            .field("boxes", &&self.boxes[..self.robot.bodies.len().min(MAX_BODIES)])
+            .finish()
+    }
 }
 
 /// Corner `k` of the box with half extents `half` at `pose` (bit `i` of `k` set: `+half_i`).
@@ -149,13 +169,13 @@ pub fn box_corner<T: Real>(pose: &Pose<T>, half: &Vector3<T>, k: usize) -> Vecto
     pose.transform_point(&Vector3::new(s(0, half.x), s(1, half.y), s(2, half.z)))
 }
 
-/// Forward kinematics: world pose of every frame and collision box, each finger at the
-/// default opening (`robot::FINGER_OPENING_DEFAULT`, 0.025 m). See [`forward_with`].
+/// Forward kinematics: world pose of every frame and collision box, each finger (if the arm
+/// has a gripper) at the default opening (0.025 m for the Panda). See [`forward_with`].
 ///
 /// Any finite angle is accepted (limits are the planner's business); NaN or infinity is
 /// refused with [`Error::NonFiniteJoint`], so every output is finite.
-pub fn forward<T: Real>(q: &Joints<T>) -> Result<Kinematics<T>, Error> {
-    forward_with(q, T::robot().finger_default)
+pub fn forward<T: Real, const J: usize>(robot: &'static Robot<T, J>, q: &[T; J]) -> Result<Kinematics<T, J>, Error> {
+    forward_with(robot, q, robot.gripper.map_or(T::zero(), |g| g.default))
 }
 
 /// Forward kinematics with each finger opened to `finger` metres (the value of both finger
@@ -163,32 +183,38 @@ pub fn forward<T: Real>(q: &Joints<T>) -> Result<Kinematics<T>, Error> {
 /// opening the result is [`forward`]'s, bit for bit.
 ///
 /// Joints as in [`forward`] (checked first); an opening outside the URDF's finger limits
-/// (`robot::FINGER_OPENING_MIN..=FINGER_OPENING_MAX`), or NaN, is [`Error::BadParameter`].
-pub fn forward_with<T: Real>(q: &Joints<T>, finger: T) -> Result<Kinematics<T>, Error> {
+/// ([`crate::robot::Gripper`]), or NaN, is [`Error::BadParameter`]; an arm without a gripper
+/// takes 0 only.
+pub fn forward_with<T: Real, const J: usize>(
+    robot: &'static Robot<T, J>,
+    q: &[T; J],
+    finger: T,
+) -> Result<Kinematics<T, J>, Error> {
     let mut k = Kinematics {
-        frames: [Pose::identity(); FRAMES],
-        boxes: [Pose::identity(); BODIES],
+        robot,
+        frames: [Pose::identity(); MAX_FRAMES],
+        boxes: [Pose::identity(); MAX_BODIES],
     };
     forward_into(q, finger, &mut k)?;
     Ok(k)
 }
 
-/// [`forward_with`] into `out`, in place (the costs' inner loop: no copy of the result). On an
-/// error `out` is unchanged.
-pub fn forward_into<T: Real>(q: &Joints<T>, finger: T, out: &mut Kinematics<T>) -> Result<(), Error> {
+/// [`forward_with`] into `out`, for `out`'s arm, in place (the costs' inner loop: no copy of
+/// the result). On an error `out` is unchanged.
+pub fn forward_into<T: Real, const J: usize>(q: &[T; J], finger: T, out: &mut Kinematics<T, J>) -> Result<(), Error> {
     for (i, &qi) in q.iter().enumerate() {
         if !qi.finite() {
             return Err(Error::NonFiniteJoint { joint: i as u8 });
         }
     }
-    let robot = T::robot();
-    if !(finger >= robot.finger_lower && finger <= robot.finger_upper) {
+    let robot = out.robot;
+    let (lower, upper) = robot.gripper.map_or((T::zero(), T::zero()), |g| (g.lower, g.upper));
+    if !(finger >= lower && finger <= upper) {
         return Err(Error::BadParameter);
     }
     let frames = &mut out.frames;
     frames[0] = Pose::identity();
-    for i in 1..FRAMES {
-        let spec = &robot.frames[i];
+    for (i, spec) in robot.frames.iter().enumerate().take(MAX_FRAMES).skip(1) {
         let rotation = match spec.joint.and_then(|j| q.get(j)) {
             Some(&angle) => {
                 let (s, c) = angle.sin_cos_libm();
@@ -203,36 +229,43 @@ pub fn forward_into<T: Real>(q: &Joints<T>, finger: T, out: &mut Kinematics<T>) 
         let parent = frames[spec.parent.min(i - 1)];
         frames[i] = parent.compose(&rotation, &translation);
     }
+    let last = robot.frames.len().clamp(1, MAX_FRAMES) - 1;
     for (pose, body) in out.boxes.iter_mut().zip(robot.bodies.iter()) {
-        *pose = out.frames[body.frame.min(FRAMES - 1)].compose(&body.rotation, &body.center);
+        *pose = out.frames[body.frame.min(last)].compose(&body.rotation, &body.center);
     }
     Ok(())
 }
 
-impl<T: Real> Kinematics<T> {
-    /// World pose of the tool centre point (`panda_grasptarget`).
+impl<T: Real, const J: usize> Kinematics<T, J> {
+    /// World pose of the tool centre point (the Panda's `panda_grasptarget`).
     pub fn tcp(&self) -> &Pose<T> {
-        &self.frames[TCP_FRAME]
+        &self.frames[self.robot.tcp_frame.min(MAX_FRAMES - 1)]
     }
 
-    /// The 8 world corners of collision body `body` (see [`CORNERS`] for the order).
+    /// The 8 world corners of collision body `body` (see [`CORNERS`] for the order); an
+    /// out-of-range `body` gives a point box at the origin.
     pub fn corners(&self, body: usize) -> [Vector3<T>; CORNERS] {
-        let half = T::robot().bodies[body % BODIES].half_extents;
-        let pose = &self.boxes[body % BODIES];
+        let half = self
+            .robot
+            .bodies
+            .get(body)
+            .map_or_else(Vector3::zeros, |b| b.half_extents);
+        let pose = &self.boxes[body % MAX_BODIES];
         core::array::from_fn(|k| box_corner(pose, &half, k))
     }
 
-    /// The corners of every collision body.
-    pub fn all_corners(&self) -> [[Vector3<T>; CORNERS]; BODIES] {
+    /// The corners of every collision body (point boxes past the arm's bodies).
+    pub fn all_corners(&self) -> [[Vector3<T>; CORNERS]; MAX_BODIES] {
         core::array::from_fn(|b| self.corners(b))
     }
 
     /// Reverse mode: the gradient with respect to the joints of a scalar whose gradient with
     /// respect to every box corner is `corner_grad`.
-    pub fn adjoint(&self, corner_grad: &CornerGradient<T>) -> Result<Joints<T>, Error> {
-        let robot = T::robot();
+    pub fn adjoint(&self, corner_grad: &CornerGradient<T>) -> Result<[T; J], Error> {
+        let robot = self.robot;
+        let last = robot.frames.len().clamp(1, MAX_FRAMES) - 1;
         let mut cot = Cotangent::new();
-        for (b, grads) in corner_grad.iter().enumerate() {
+        for (b, (grads, body)) in corner_grad.iter().zip(robot.bodies).enumerate() {
             // Costs pull on few bodies at a time: skip the rest without placing their corners.
             let mut any = false;
             for g in grads {
@@ -248,7 +281,7 @@ impl<T: Real> Kinematics<T> {
                 force += g;
                 moment += c.cross(g);
             }
-            let frame = robot.bodies[b].frame.min(FRAMES - 1);
+            let frame = body.frame.min(last);
             cot.force[frame] += force;
             cot.moment[frame] += moment;
         }
@@ -256,16 +289,15 @@ impl<T: Real> Kinematics<T> {
     }
 
     /// Reverse mode for any upstream gradient collected in `cot`: one leaf-to-root sweep.
-    pub fn joint_gradient(&self, cot: &Cotangent<T>) -> Result<Joints<T>, Error> {
+    pub fn joint_gradient(&self, cot: &Cotangent<T>) -> Result<[T; J], Error> {
         // x·0 is 0 for every finite x and NaN otherwise: the probe saw every input.
         if cot.probe != T::zero() {
             return Err(Error::NonFiniteGradient);
         }
-        let robot = T::robot();
+        let robot = self.robot;
         let (mut force, mut moment) = (cot.force, cot.moment);
-        let mut dq = [T::zero(); JOINTS];
-        for i in (1..FRAMES).rev() {
-            let spec = &robot.frames[i];
+        let mut dq = [T::zero(); J];
+        for (i, spec) in robot.frames.iter().enumerate().take(MAX_FRAMES).skip(1).rev() {
             if let Some(slot) = spec.joint.and_then(|j| dq.get_mut(j)) {
                 let pose = &self.frames[i];
                 let axis = pose.rotation * spec.axis;
@@ -287,18 +319,18 @@ impl<T: Real> Kinematics<T> {
         }
     }
 
-    /// The 6×7 geometric Jacobian of frame `frame`: rows 0-2 the linear velocity of its origin,
+    /// The 6×J geometric Jacobian of frame `frame`: rows 0-2 the linear velocity of its origin,
     /// rows 3-5 its angular velocity, per unit joint rate. Joints that do not move the frame
     /// give zero columns; an out-of-range `frame` gives all zeros.
-    pub fn jacobian(&self, frame: usize) -> [[T; JOINTS]; 6] {
-        let robot = T::robot();
-        let mut jac = [[T::zero(); JOINTS]; 6];
-        if frame >= FRAMES {
+    pub fn jacobian(&self, frame: usize) -> [[T; J]; 6] {
+        let robot = self.robot;
+        let mut jac = [[T::zero(); J]; 6];
+        if frame >= robot.frames.len().min(MAX_FRAMES) {
             return jac;
         }
         let target = self.frames[frame].translation;
-        for (i, spec) in robot.frames.iter().enumerate() {
-            let Some(j) = spec.joint.filter(|&j| j < JOINTS) else {
+        for (i, spec) in robot.frames.iter().enumerate().take(MAX_FRAMES) {
+            let Some(j) = spec.joint.filter(|&j| j < J) else {
                 continue;
             };
             if !robot.is_ancestor(i, frame) {
@@ -316,14 +348,15 @@ impl<T: Real> Kinematics<T> {
     }
 
     /// The TCP Jacobian (see [`Self::jacobian`]); inverse kinematics uses it.
-    pub fn tcp_jacobian(&self) -> [[T; JOINTS]; 6] {
-        self.jacobian(TCP_FRAME)
+    pub fn tcp_jacobian(&self) -> [[T; J]; 6] {
+        self.jacobian(self.robot.tcp_frame)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::robot::{BODIES, FRAMES, PANDA, PANDA_F64};
 
     const READY: [f32; 7] = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
 
@@ -331,14 +364,14 @@ mod tests {
     fn refuses_non_finite_joints() {
         let mut q = READY;
         q[3] = f32::NAN;
-        assert_eq!(forward(&q), Err(Error::NonFiniteJoint { joint: 3 }));
+        assert_eq!(forward(&PANDA, &q), Err(Error::NonFiniteJoint { joint: 3 }));
         q[3] = f32::INFINITY;
-        assert_eq!(forward(&q), Err(Error::NonFiniteJoint { joint: 3 }));
+        assert_eq!(forward(&PANDA, &q), Err(Error::NonFiniteJoint { joint: 3 }));
     }
 
     #[test]
     fn refuses_non_finite_gradients_and_reports_overflow() {
-        let k = forward(&READY).unwrap();
+        let k = forward(&PANDA, &READY).unwrap();
         let mut g = [[Vector3::zeros(); CORNERS]; BODIES];
         g[4][2].y = f32::NAN;
         assert_eq!(k.adjoint(&g), Err(Error::NonFiniteGradient));
@@ -349,7 +382,7 @@ mod tests {
     #[test]
     fn zero_configuration_tcp_is_straight_up_and_forward() {
         // All-zero joints: the arm stands up with the flange offset along +x.
-        let k = forward(&[0.0f64; 7]).unwrap();
+        let k = forward(&PANDA_F64, &[0.0f64; 7]).unwrap();
         let p = k.tcp().translation;
         assert!((p.x - 0.088).abs() < 1e-9, "{p}");
         assert!(p.y.abs() < 1e-9, "{p}");
@@ -360,12 +393,12 @@ mod tests {
     fn the_fingers_slide_by_the_opening_along_the_hands_y() {
         use crate::robot::{FINGER_OPENING_DEFAULT, HAND_FRAME};
         let (left, right) = (10, 11);
-        let base = forward(&READY).unwrap();
+        let base = forward(&PANDA, &READY).unwrap();
         // The default opening is `forward`'s, bit for bit.
-        assert_eq!(forward_with(&READY, FINGER_OPENING_DEFAULT).unwrap(), base);
+        assert_eq!(forward_with(&PANDA, &READY, FINGER_OPENING_DEFAULT).unwrap(), base);
         let q64 = READY.map(f64::from);
         for w in [0.0, 0.01, 0.025, 0.04] {
-            let k = forward_with(&q64, w).unwrap();
+            let k = forward_with(&PANDA_F64, &q64, w).unwrap();
             let hand = &k.frames[HAND_FRAME];
             let y = hand.rotation.column(1).into_owned();
             // In the hand frame: each finger sits at (0, ±w, 0.0584), the URDF's origin.
@@ -378,7 +411,7 @@ mod tests {
             assert!((gap - y * (2.0 * w)).norm() < 1e-12, "{w}: {gap}");
             assert!((k.frames[left].rotation - hand.rotation).norm() < 1e-12);
             // Nothing else moves: every other frame and box is the default's.
-            let d = forward(&q64).unwrap();
+            let d = forward(&PANDA_F64, &q64).unwrap();
             for f in (0..FRAMES).filter(|&f| f != left && f != right) {
                 assert_eq!(k.frames[f], d.frames[f], "frame {f}");
             }
@@ -395,18 +428,21 @@ mod tests {
     #[test]
     fn refuses_openings_outside_the_finger_limits() {
         for w in [f32::NAN, -1e-6, 0.0401, f32::INFINITY, -f32::INFINITY] {
-            assert_eq!(forward_with(&READY, w), Err(Error::BadParameter), "{w}");
+            assert_eq!(forward_with(&PANDA, &READY, w), Err(Error::BadParameter), "{w}");
         }
-        assert!(forward_with(&READY, 0.0).is_ok() && forward_with(&READY, 0.04).is_ok());
+        assert!(forward_with(&PANDA, &READY, 0.0).is_ok() && forward_with(&PANDA, &READY, 0.04).is_ok());
         // A bad joint is named first.
         let mut q = READY;
         q[2] = f32::NAN;
-        assert_eq!(forward_with(&q, f32::NAN), Err(Error::NonFiniteJoint { joint: 2 }));
+        assert_eq!(
+            forward_with(&PANDA, &q, f32::NAN),
+            Err(Error::NonFiniteJoint { joint: 2 })
+        );
     }
 
     #[test]
     fn rotations_stay_orthonormal() {
-        let k = forward(&READY).unwrap();
+        let k = forward(&PANDA, &READY).unwrap();
         for pose in k.frames.iter().chain(k.boxes.iter()) {
             let err = (pose.rotation.transpose() * pose.rotation - Matrix3::identity()).norm();
             assert!(err < 1e-5, "{err}");

@@ -1,12 +1,15 @@
-//! The Panda as frozen by `edmp-codegen` at build time: link frames, collision boxes, limits.
-//! The one input the tables leave open is the gripper opening: each finger frame is its fixed
-//! transform at opening 0 plus [`FrameSpec::slide`] times the opening (see
-//! [`crate::robot::kinematics::forward_with`]).
+//! The arms as frozen by `edmp-codegen` at build time ([`arms`]): link frames, collision
+//! boxes and hulls, limits, self-collision pairs. An arm is a [`Robot`] table; the code that
+//! moves one ([`kinematics`], [`reach`]) takes the table and is generic over its number of
+//! joints `J`. The one input the tables leave open is the gripper opening, for arms with a
+//! gripper: each finger frame is its fixed transform at opening 0 plus [`FrameSpec::slide`]
+//! times the opening (see [`crate::robot::kinematics`]).
 //!
-//! No number of the robot is typed here: the tables come from `OUT_DIR/panda.rs`, which the
-//! build script generates from `weights/panda/panda.urdf` and its collision meshes. Read the
-//! generated file (or run `cargo run -p edmp-codegen`) to see each number and its origin.
+//! No number of an arm is typed here: the tables come from `OUT_DIR/robot_NAME.rs`, which the
+//! build script generates from the arm's URDF and collision meshes. Read the generated file (or
+//! run `cargo run -p edmp-codegen -- NAME`) to see each number and its origin.
 
+pub mod arms;
 pub mod ik;
 pub mod kinematics;
 pub mod reach;
@@ -55,52 +58,66 @@ pub struct BodySpec<T> {
     pub half_extents: Vector3<T>,
 }
 
-/// Every table of the robot in one scalar type.
+/// An arm's gripper: the range of its opening and the default an absent `gripper` field means.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Robot<T> {
-    /// Link frames, parents before children.
-    pub frames: [FrameSpec<T>; FRAMES],
-    /// Collision bodies.
-    pub bodies: [BodySpec<T>; BODIES],
-    /// Collision-mesh vertices of every body (link frame), sliced by `BodySpec::hull_start/len`.
-    pub hull_points: [Vector3<T>; HULL_POINTS],
-    /// Franka's official lower joint limits (URDF `safety_controller`), used for planning.
-    pub soft_lower: [T; JOINTS],
-    /// Franka's official upper joint limits.
-    pub soft_upper: [T; JOINTS],
-    /// URDF `<limit lower>`: the hardware range, wider than the soft one.
-    pub hard_lower: [T; JOINTS],
-    /// URDF `<limit upper>`.
-    pub hard_upper: [T; JOINTS],
+pub struct Gripper<T> {
     /// The finger opening an absent `gripper` field means (docs/formats.md): 0.025 m.
-    pub finger_default: T,
+    pub default: T,
     /// Smallest finger opening (the driving finger joint's `<limit lower>`).
-    pub finger_lower: T,
+    pub lower: T,
     /// Largest finger opening (its `<limit upper>`).
-    pub finger_upper: T,
+    pub upper: T,
 }
 
-include!(concat!(env!("OUT_DIR"), "/panda.rs"));
+/// Every table of one arm in one scalar type; `J` is its number of actuated joints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Robot<T: 'static, const J: usize> {
+    /// The scene format's `robot` name.
+    pub name: &'static str,
+    /// Link frames, parents before children; frame 0 is the root, the world frame.
+    pub frames: &'static [FrameSpec<T>],
+    /// Collision bodies.
+    pub bodies: &'static [BodySpec<T>],
+    /// Collision-mesh vertices of every body (link frame), sliced by `BodySpec::hull_start/len`.
+    pub hull_points: &'static [Vector3<T>],
+    /// Body pairs `(a, b)`, `a < b`, checked against each other for self-collision.
+    pub self_pairs: &'static [(u8, u8)],
+    /// URDF link name of each frame.
+    pub frame_names: &'static [&'static str],
+    /// URDF link name of each collision body.
+    pub body_names: &'static [&'static str],
+    /// URDF joint name of each actuated joint.
+    pub joint_names: [&'static str; J],
+    /// The tool centre point's frame (pose goals).
+    pub tcp_frame: usize,
+    /// The frame a held object is attached to.
+    pub hand_frame: usize,
+    /// The planning range's lower ends (the Panda: Franka's official limits, URDF
+    /// `safety_controller`; other arms: `<limit>`).
+    pub soft_lower: [T; J],
+    /// The planning range's upper ends.
+    pub soft_upper: [T; J],
+    /// URDF `<limit lower>`: the hardware range, at least as wide as the planning one.
+    pub hard_lower: [T; J],
+    /// URDF `<limit upper>`.
+    pub hard_upper: [T; J],
+    /// The gripper, for arms with one.
+    pub gripper: Option<Gripper<T>>,
+}
 
-/// The Panda in `f32`: what the planner uses.
-// The tables are written once at f64 precision; the compiler rounds each literal to f32 here.
-// URDF numbers such as the hardware limit -3.1416 are data, not approximations of π.
-pub static PANDA: Robot<f32> = PANDA_TABLES;
-/// The same tables as a constant, for tables derived from them at compile time
-/// ([`crate::robot::reach`]; a `static` cannot be read there).
-#[allow(clippy::excessive_precision, clippy::approx_constant)]
-pub(crate) const PANDA_TABLES: Robot<f32> = panda_tables!();
-/// The Panda in `f64`: for oracles (finite differences) and host-side tools.
-#[allow(clippy::approx_constant)]
-pub static PANDA_F64: Robot<f64> = panda_tables!();
+pub(crate) use arms::panda::TABLES as PANDA_TABLES;
+pub use arms::panda::{
+    BODIES, BODY_NAMES, FINGER_OPENING_DEFAULT, FINGER_OPENING_MAX, FINGER_OPENING_MIN, FRAME_NAMES, FRAMES,
+    HAND_FRAME, HULL_POINTS, JOINT_NAMES, JOINTS, TCP_FRAME,
+};
+pub use arms::panda::{ROBOT as PANDA, ROBOT_F64 as PANDA_F64};
+pub use arms::{MAX_BODIES, MAX_FRAMES};
 
 /// The scalar types the kinematics run in: `f32` (planner) and `f64` (oracles).
 ///
 /// Every transcendental goes through the `libm` crate, so results are bit-identical on every
 /// target (x86_64, thumbv7em) whatever the platform's own math library does.
 pub trait Real: RealField + Copy {
-    /// The robot tables in this type.
-    fn robot() -> &'static Robot<Self>;
     /// `(sin x, cos x)` through `libm`.
     fn sin_cos_libm(self) -> (Self, Self);
     /// Neither NaN nor infinite.
@@ -108,9 +125,6 @@ pub trait Real: RealField + Copy {
 }
 
 impl Real for f32 {
-    fn robot() -> &'static Robot<Self> {
-        &PANDA
-    }
     fn sin_cos_libm(self) -> (Self, Self) {
         libm::sincosf(self)
     }
@@ -120,9 +134,6 @@ impl Real for f32 {
 }
 
 impl Real for f64 {
-    fn robot() -> &'static Robot<Self> {
-        &PANDA_F64
-    }
     fn sin_cos_libm(self) -> (Self, Self) {
         libm::sincos(self)
     }
@@ -131,10 +142,10 @@ impl Real for f64 {
     }
 }
 
-impl<T: Real> Robot<T> {
+impl<T: Real, const J: usize> Robot<T, J> {
     /// Whether every joint lies within the soft (planning) limits, `tolerance` outside allowed.
-    pub fn within_soft_limits(&self, q: &[T; JOINTS], tolerance: T) -> bool {
-        (0..JOINTS).all(|i| q[i] >= self.soft_lower[i] - tolerance && q[i] <= self.soft_upper[i] + tolerance)
+    pub fn within_soft_limits(&self, q: &[T; J], tolerance: T) -> bool {
+        (0..J).all(|i| q[i] >= self.soft_lower[i] - tolerance && q[i] <= self.soft_upper[i] + tolerance)
     }
 
     /// The frame turned by actuated joint `joint`.
@@ -153,14 +164,14 @@ impl<T: Real> Robot<T> {
     /// Whether `ancestor` is `frame` or lies on its path to the root.
     pub fn is_ancestor(&self, ancestor: usize, frame: usize) -> bool {
         let mut f = frame;
-        for _ in 0..FRAMES {
+        for _ in 0..self.frames.len() {
             if f == ancestor {
                 return true;
             }
-            if f == 0 || f >= FRAMES {
-                return false;
+            match self.frames.get(f) {
+                Some(spec) if f != 0 => f = spec.parent,
+                _ => return false,
             }
-            f = self.frames[f].parent;
         }
         false
     }
@@ -181,7 +192,7 @@ mod tests {
             assert!(PANDA.soft_lower[j] < PANDA.soft_upper[j]);
             assert!(PANDA.hard_lower[j] <= PANDA.soft_lower[j] && PANDA.soft_upper[j] <= PANDA.hard_upper[j]);
         }
-        for b in &PANDA_F64.bodies {
+        for b in PANDA_F64.bodies {
             let r = b.rotation;
             assert!((r.transpose() * r - Matrix3::identity()).norm() < 1e-9);
             assert!(r.determinant() > 0.0);
@@ -210,13 +221,16 @@ mod tests {
         // into the translation (before the opening was an input) put them, in f32 bits.
         for (f, y) in [(10, 0.025f32), (11, -0.025)] {
             let spec = &PANDA.frames[f];
-            let at_default = spec.translation + spec.slide.unwrap() * PANDA.finger_default;
+            let at_default = spec.translation + spec.slide.unwrap() * FINGER_OPENING_DEFAULT;
             assert_eq!(at_default, Vector3::new(0.0f32, y, 0.0584), "frame {f}");
         }
+        let gripper = PANDA.gripper.unwrap();
         assert_eq!(
-            (PANDA.finger_default, PANDA.finger_lower, PANDA.finger_upper),
+            (gripper.default, gripper.lower, gripper.upper),
             (FINGER_OPENING_DEFAULT, FINGER_OPENING_MIN, FINGER_OPENING_MAX)
         );
+        assert_eq!((PANDA.tcp_frame, PANDA.hand_frame), (TCP_FRAME, HAND_FRAME));
+        assert_eq!((PANDA.frames.len(), PANDA.bodies.len()), (FRAMES, BODIES));
         assert_eq!(
             (FINGER_OPENING_MIN, FINGER_OPENING_DEFAULT, FINGER_OPENING_MAX),
             (0.0, 0.025, 0.04)

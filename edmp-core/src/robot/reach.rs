@@ -137,7 +137,10 @@ mod tests {
             let q: [f32; JOINTS] = core::array::from_fn(|j| rng.uniform_f32(PANDA.soft_lower[j], PANDA.soft_upper[j]));
             let scale = rng.uniform_f32(0.0, 0.3);
             let q2: [f32; JOINTS] = core::array::from_fn(|j| q[j] + scale * rng.uniform_f32(-1.0, 1.0));
-            let (a, b) = (forward::<f32>(&q).unwrap(), forward::<f32>(&q2).unwrap());
+            let (a, b) = (
+                forward(&crate::robot::PANDA, &q).unwrap(),
+                forward(&crate::robot::PANDA, &q2).unwrap(),
+            );
             for (body, reach) in BODY_REACH.iter().enumerate() {
                 let frame = PANDA.bodies[body].frame;
                 let step: [f32; JOINTS] = core::array::from_fn(|j| (q2[j] - q[j]).abs());

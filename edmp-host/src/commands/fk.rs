@@ -86,7 +86,7 @@ pub fn document(q: &Joints<f32>) -> Result<serde_json::Value, Error> {
 
 fn report(q: &Joints<f32>) -> Result<Report, Error> {
     let q = *q;
-    let k = forward(&q)?;
+    let k = forward(&PANDA, &q)?;
     Ok(Report {
         joints: q,
         within_soft_limits: PANDA.within_soft_limits(&q, 0.0),

@@ -436,7 +436,11 @@ fn draw_tcp_path(
 ) -> Result<(), String> {
     let points: Vec<Vector3<f32>> = path
         .iter()
-        .map(|q| forward(q).map(|k| k.tcp().translation).map_err(|e| e.to_string()))
+        .map(|q| {
+            forward(&PANDA, q)
+                .map(|k| k.tcp().translation)
+                .map_err(|e| e.to_string())
+        })
         .collect::<Result<_, _>>()?;
     for view in VIEWS {
         for pair in points.windows(2) {
@@ -447,7 +451,7 @@ fn draw_tcp_path(
 }
 
 fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, finger: f32, color: [f32; 3], alpha: f32) -> Result<(), String> {
-    let k = forward_with(q, finger).map_err(|e| e.to_string())?;
+    let k = forward_with(&PANDA, q, finger).map_err(|e| e.to_string())?;
     for b in 0..BODIES {
         let pose = &k.frames[PANDA.bodies[b].frame];
         let pts: Vec<_> = PANDA.hull(b).iter().map(|p| pose.transform_point(p)).collect();

@@ -450,7 +450,7 @@ mod tests {
     fn the_ends_are_checked_at_the_scenes_opening() {
         // A plate between the fingers at the start: free with the fingers open, in contact closed.
         let ready = [0.0f32, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
-        let k = edmp_core::robot::kinematics::forward(&ready).unwrap();
+        let k = edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &ready).unwrap();
         let hand = &k.frames[edmp_core::robot::HAND_FRAME];
         let c = hand.transform_point(&nalgebra::Vector3::new(0.0, 0.0, 0.095));
         let q = hand.quaternion_wxyz();

@@ -834,7 +834,7 @@ fn tcp_offset(link: &str, path: &str) -> R<Isometry3<f64>> {
                 ),
             )
         })?;
-    let k = forward::<f64>(&[0.0; JOINTS]).map_err(|e| at(path, e.to_string()))?;
+    let k = forward(&edmp_core::robot::PANDA_F64, &[0.0; JOINTS]).map_err(|e| at(path, e.to_string()))?;
     let iso = |p: &edmp_core::robot::kinematics::Pose<f64>| {
         let r = Rotation3::from_matrix_unchecked(Matrix3::from(p.rotation));
         Isometry3::from_parts(

@@ -510,7 +510,7 @@ pub fn encloses(vertices: &[[f32; 3]], triangles: &[[u32; 3]], p: &Vector3<f32>)
 /// The first robot body (by name) whose box centre lies inside a closed mesh at `q`, and that
 /// mesh's obstacle index: an end there touches no triangle yet is inside the obstacle.
 pub fn inside_closed_mesh(surfaces: &Surfaces, q: &Joints<f32>, finger: f32) -> Option<(&'static str, usize)> {
-    let k = edmp_core::robot::kinematics::forward_with(q, finger).ok()?;
+    let k = edmp_core::robot::kinematics::forward_with(&edmp_core::robot::PANDA, q, finger).ok()?;
     for o in &surfaces.obstacles {
         let SurfaceKind::Mesh { vertices, triangles } = &o.kind else {
             continue;

@@ -137,7 +137,9 @@ pub(crate) fn reach(
     for _ in 0..attempts {
         let pose = region.sample(rng);
         if let Ok(s) = solve(&pose, &NEUTRAL, scene, &ik) {
-            let reached = *edmp_core::robot::kinematics::forward(&s.joints).ok()?.tcp();
+            let reached = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &s.joints)
+                .ok()?
+                .tcp();
             return Some((s.joints, reached));
         }
     }
@@ -188,7 +190,9 @@ pub(crate) fn problem(family: Family, kind: Kind, seed: u64) -> Option<Problem> 
         Kind::NeutralGoal => {
             let (s, _) = reach(&scene, &env.regions[first], &mut rng, 20)?;
             let g = neutral(&scene, &mut rng)?;
-            let pose = *edmp_core::robot::kinematics::forward(&g).ok()?.tcp();
+            let pose = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &g)
+                .ok()?
+                .tcp();
             (s, g, pose)
         }
     };
@@ -232,7 +236,9 @@ fn targeted(
         Kind::NeutralGoal => {
             let (s, _) = reach(&scene, &target, rng, 20)?;
             let g = neutral(&scene, rng)?;
-            let pose = *edmp_core::robot::kinematics::forward(&g).ok()?.tcp();
+            let pose = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &g)
+                .ok()?
+                .tcp();
             (s, g, pose)
         }
     };

@@ -208,7 +208,7 @@ fn quaternion(rotation: &nalgebra::Matrix3<f32>) -> [f64; 4] {
 /// One animation sample: the world pose of every link frame (`x y z qw qx qy qz` each, frames
 /// in `FRAME_NAMES` order, flattened) and the TCP position, from the core's FK.
 fn sample(q: &Joints<f32>, finger: f32, at: &str) -> Result<(Vec<f64>, [f64; 3]), String> {
-    let k = forward_with(q, finger).map_err(|e| format!("{at}: {e}"))?;
+    let k = forward_with(&edmp_core::robot::PANDA, q, finger).map_err(|e| format!("{at}: {e}"))?;
     let mut poses = Vec::with_capacity(FRAMES * 7);
     for frame in &k.frames {
         poses.extend(micro3(&frame.translation));
@@ -632,7 +632,7 @@ mod tests {
         assert_eq!((times[0], times[1], times[75]), (0.0, 0.02, 1.5));
         assert_eq!(data["title"], "t</script>");
         // Each sample is the core's FK of its trajectory point: 13 frames, the TCP as its own.
-        let k = forward_with(&trajectory[1500].1, problem.scene().gripper()).unwrap();
+        let k = forward_with(&edmp_core::robot::PANDA, &trajectory[1500].1, problem.scene().gripper()).unwrap();
         let tcp: [f64; 3] = serde_json::from_value(data["samples"]["tcp"][75].clone()).unwrap();
         let poses: Vec<f64> = serde_json::from_value(data["samples"]["poses"][75].clone()).unwrap();
         assert_eq!(poses.len(), 7 * FRAMES);

@@ -1,0 +1,58 @@
+//! The arms edmp-rs knows, each a URDF and the few facts a URDF does not say: which link is
+//! the tool centre point, where a held object attaches, which limits plan, and how the
+//! self-collision pairs are chosen (docs/formats.md, "Other arms").
+
+/// Where an arm's planning limits come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LimitSource {
+    /// `<safety_controller soft_lower_limit soft_upper_limit>` (Franka's official range).
+    SafetyController,
+    /// `<limit lower upper>`: the URDF's only range.
+    Limit,
+}
+
+/// How the self-collision pairs are chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PairRule {
+    /// Bodies whose numbers of revolute joints to the root differ by two or more (the Panda's:
+    /// link7, hand and fingers share one level and form one rigid group).
+    Levels,
+    /// Links that are not parent and child in the chain and do not touch at the all-zero
+    /// configuration (the rule docs/formats.md gives every other arm).
+    ApartAtZero,
+}
+
+/// One arm: its URDF and the facts around it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ArmSpec {
+    /// The scene format's `robot` name, the generated module's name and the cargo feature.
+    pub name: &'static str,
+    /// The URDF, relative to the repository root.
+    pub urdf: &'static str,
+    /// The tool centre point's link (pose goals).
+    pub tcp_link: &'static str,
+    /// The link a held object is attached to.
+    pub hand_link: &'static str,
+    /// Which limits plan.
+    pub limits: LimitSource,
+    /// Whether a gripper opening drives prismatic finger joints.
+    pub gripper: bool,
+    /// How the self-collision pairs are chosen.
+    pub pairs: PairRule,
+}
+
+/// Every arm, the Panda first.
+pub const ARMS: [ArmSpec; 1] = [ArmSpec {
+    name: "panda",
+    urdf: "weights/panda/panda.urdf",
+    tcp_link: "panda_grasptarget",
+    hand_link: "panda_hand",
+    limits: LimitSource::SafetyController,
+    gripper: true,
+    pairs: PairRule::Levels,
+}];
+
+/// The arm called `name`.
+pub fn arm(name: &str) -> Option<&'static ArmSpec> {
+    ARMS.iter().find(|a| a.name == name)
+}

@@ -1,0 +1,41 @@
+//! The arms compiled in, one module each, with the tables `edmp-codegen` generated from the
+//! arm's URDF (cargo features `panda`, `iiwa7`, `xarm6`; the firmware picks one). Each module
+//! holds its arm's [`Robot`] in `f32` (`ROBOT`, what the planner uses) and `f64` (`ROBOT_F64`,
+//! for oracles and host-side tools), and its sizes and names as constants.
+
+use crate::robot::{BodySpec, FrameSpec, Gripper, Robot};
+use nalgebra::{Matrix3, Vector3};
+
+// The most frames and bodies of any arm compiled in: the capacity of per-configuration
+// buffers ([`crate::robot::kinematics::Kinematics`]).
+include!(concat!(env!("OUT_DIR"), "/arms.rs"));
+
+/// Declares one arm's module from its generated tables.
+macro_rules! arm {
+    ($(#[$doc:meta])* $name:ident, $file:literal) => {
+        $(#[$doc])*
+        #[allow(clippy::excessive_precision, clippy::approx_constant)]
+        pub mod $name {
+            use super::*;
+            include!(concat!(env!("OUT_DIR"), "/", $file));
+            /// The arm in `f32`: what the planner uses.
+            // The tables are written once at f64 precision; the compiler rounds each literal
+            // to f32 here. URDF numbers such as the limit -3.1416 are data, not π.
+            pub static ROBOT: Robot<f32, JOINTS> = tables!();
+            /// The same tables as a constant, for tables derived from them at compile time
+            /// ([`crate::robot::reach`]; a `static` cannot be read there).
+            #[allow(dead_code)]
+            pub(crate) const TABLES: Robot<f32, JOINTS> = tables!();
+            /// The arm in `f64`: for oracles (finite differences) and host-side tools.
+            pub static ROBOT_F64: Robot<f64, JOINTS> = tables!();
+            const _: () = assert!(FRAMES <= MAX_FRAMES && BODIES <= MAX_BODIES);
+        }
+    };
+}
+
+#[cfg(feature = "panda")]
+arm!(
+    /// The Franka Panda with its hand (`weights/panda/panda.urdf`).
+    panda,
+    "robot_panda.rs"
+);
