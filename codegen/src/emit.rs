@@ -117,10 +117,10 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     wl(w, "");
     wl(
         w,
-        "/// The robot tables, instantiated for `f32` and `f64` by `robot::arms`.",
+        "/// The robot tables, instantiated for `f32` and `f64` by `robot::arms`, which adds the fields\n/// derived from them at compile time (the reach bounds).",
     );
     wl(w, "macro_rules! tables {");
-    wl(w, "    () => {");
+    wl(w, "    ($($derived:tt)*) => {");
     wl(w, "        Robot {");
     wl(w, &format!("            name: {:?},", chain.arm.name));
     wl(w, "            frames: &[");
@@ -278,6 +278,7 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         }
         None => wl(w, "            gripper: None,"),
     }
+    wl(w, "            $($derived)*");
     wl(w, "        }");
     wl(w, "    };");
     wl(w, "}");

@@ -61,7 +61,7 @@ fn scene(rng: &mut Rng, path: &[[f32; 7]; H]) -> Scene<'static, 64> {
         .unwrap();
         let mut trial = scene.clone();
         trial.push(o).unwrap();
-        if check_trajectory(&trial, path, &CheckConfig::default(), true)
+        if check_trajectory(&edmp_core::robot::PANDA, &trial, path, &CheckConfig::default(), true)
             .unwrap()
             .is_free()
         {
@@ -159,11 +159,28 @@ fn bench(c: &mut Criterion) {
             }
         }
     }
-    let report = check_trajectory(&scene, &batch[0], &CheckConfig::default(), false).unwrap();
+    let report = check_trajectory(
+        &edmp_core::robot::PANDA,
+        &scene,
+        &batch[0],
+        &CheckConfig::default(),
+        false,
+    )
+    .unwrap();
     assert!(report.is_free());
     group.bench_function(
         format!("exact check, 50 waypoints ({} states), 20 obstacles", report.states),
-        |b| b.iter(|| check_trajectory(&scene, black_box(&batch[0]), &CheckConfig::default(), true)),
+        |b| {
+            b.iter(|| {
+                check_trajectory(
+                    &edmp_core::robot::PANDA,
+                    &scene,
+                    black_box(&batch[0]),
+                    &CheckConfig::default(),
+                    true,
+                )
+            })
+        },
     );
     group.finish();
 }

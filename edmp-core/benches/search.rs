@@ -24,8 +24,9 @@ fn bench(c: &mut Criterion) {
     let start = [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
     let goal = [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
     let check = CheckConfig::DEFAULT;
-    let mut edge_free =
-        |a: &Joints<f32>, b: &Joints<f32>| Ok(check_trajectory(&scene, &[*a, *b], &check, true)?.is_free());
+    let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| {
+        Ok(check_trajectory(&edmp_core::robot::PANDA, &scene, &[*a, *b], &check, true)?.is_free())
+    };
     let config = SearchConfig::DEFAULT;
     let mut space = Box::new(SearchSpace::<2048>::new());
     for seed in 1..=4 {

@@ -130,14 +130,14 @@ impl<const N: usize> Planner<'_, N> {
     fn valid_end(&self, q: &Joints<f32>) -> Result<bool, RrtError> {
         let ok = PANDA.within_soft_limits(q, 0.0);
         Ok(ok
-            && check_end(self.scene, q, &self.check)
+            && check_end(&edmp_core::robot::PANDA, self.scene, q, &self.check)
                 .map_err(RrtError::Checker)?
                 .is_none())
     }
 
     fn edge_free(&self, a: &Joints<f32>, b: &Joints<f32>) -> Result<bool, RrtError> {
         let [start, goal] = &self.ends;
-        check_segment(self.scene, a, b, [start, goal], &self.check).map_err(RrtError::Checker)
+        check_segment(&edmp_core::robot::PANDA, self.scene, a, b, [start, goal], &self.check).map_err(RrtError::Checker)
     }
 
     /// One step of `tree` towards `target`; the new node's index if the edge is free.
@@ -255,9 +255,11 @@ pub(crate) fn plan<const H: usize, const N: usize>(
     planner.shortcut(&mut path, config.shortcuts, &mut rng)?;
     let mut waypoints = resample::<H>(&path);
     let free = |w: &[Joints<f32>; H]| -> Result<bool, RrtError> {
-        Ok(check_trajectory(scene, w, &planner.check, true)
-            .map_err(RrtError::Checker)?
-            .is_free())
+        Ok(
+            check_trajectory(&edmp_core::robot::PANDA, scene, w, &planner.check, true)
+                .map_err(RrtError::Checker)?
+                .is_free(),
+        )
     };
     if !free(&waypoints)? {
         // Even spacing cut a corner: keep every vertex of the shortcut path instead (the
@@ -318,17 +320,29 @@ mod tests {
     fn finds_a_free_path_around_a_wall() {
         let scene = wall_scene();
         assert!(
-            !check_trajectory(&scene, &[LEFT, RIGHT], &CheckConfig::default(), true)
-                .unwrap()
-                .is_free()
+            !check_trajectory(
+                &edmp_core::robot::PANDA,
+                &scene,
+                &[LEFT, RIGHT],
+                &CheckConfig::default(),
+                true
+            )
+            .unwrap()
+            .is_free()
         );
         let plan = plan::<50, 8>(&scene, &LEFT, &RIGHT, &RrtConfig::default(), 3).expect("a path exists");
         assert_eq!(plan.waypoints[0], LEFT);
         assert_eq!(plan.waypoints[49], RIGHT);
         assert!(
-            check_trajectory(&scene, &plan.waypoints, &CheckConfig::default(), false)
-                .unwrap()
-                .is_free()
+            check_trajectory(
+                &edmp_core::robot::PANDA,
+                &scene,
+                &plan.waypoints,
+                &CheckConfig::default(),
+                false
+            )
+            .unwrap()
+            .is_free()
         );
         assert!(plan.waypoints.iter().all(|q| PANDA.within_soft_limits(q, 0.0)));
         assert!(path_length(&plan.waypoints) >= distance(&LEFT, &RIGHT));
@@ -351,9 +365,14 @@ mod tests {
         let scene = wall_scene();
         let inside = [0.0, 0.3, 0.0, -1.2, 0.0, 1.5, 0.785];
         assert!(
-            edmp_core::collision::checker::check_state(&scene, &inside, &CheckConfig::default())
-                .unwrap()
-                .is_some()
+            edmp_core::collision::checker::check_state(
+                &edmp_core::robot::PANDA,
+                &scene,
+                &inside,
+                &CheckConfig::default()
+            )
+            .unwrap()
+            .is_some()
         );
         assert_eq!(
             plan::<50, 8>(&scene, &inside, &RIGHT, &RrtConfig::default(), 1).err(),

@@ -474,6 +474,7 @@ fn every_example_plans_a_collision_free_path_from_its_start_to_its_goal() {
         );
         let trajectory: [[f32; 7]; 50] = core::array::from_fn(|i| waypoints[i]);
         let report = edmp_core::collision::checker::check_trajectory(
+            &edmp_core::robot::PANDA,
             &scene_of(&doc),
             &trajectory,
             &edmp_core::collision::checker::CheckConfig::DEFAULT,

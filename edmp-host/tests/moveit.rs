@@ -104,6 +104,7 @@ fn the_table_scene_with_a_joint_goal_is_the_wall_example() {
     let planned = plan_problem(&problem, &guides, &PlanConfig::DEFAULT, 0).unwrap();
     assert!(planned.plan.is_free());
     let report = check_trajectory(
+        &edmp_core::robot::PANDA,
         &problem.scene(),
         &planned.plan.paths[planned.plan.best],
         &CheckConfig::default(),
@@ -730,6 +731,7 @@ fn every_example_round_trips_through_moveit_yaml_and_plans_the_same() {
             "{name}: the imported scene plans differently"
         );
         let report = check_trajectory(
+            &edmp_core::robot::PANDA,
             &problem.scene(),
             &got.plan.paths[got.plan.best],
             &CheckConfig::default(),

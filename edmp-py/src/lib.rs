@@ -174,8 +174,14 @@ fn check(scene: &str, waypoints: Vec<Vec<f64>>) -> PyResult<String> {
     for (i, (slot, row)) in path.iter_mut().zip(&waypoints).enumerate() {
         *slot = joints_of(row, &format!("waypoints[{i}]"))?;
     }
-    let report = check_trajectory(&problem.scene(), &path, &CheckConfig::default(), false)
-        .map_err(|e| PlanError::new_err(format!("checker: {e}")))?;
+    let report = check_trajectory(
+        &edmp_core::robot::PANDA,
+        &problem.scene(),
+        &path,
+        &CheckConfig::default(),
+        false,
+    )
+    .map_err(|e| PlanError::new_err(format!("checker: {e}")))?;
     let first = report.first_contact.map(
         |c| json!({"segment": c.segment, "step": c.step, "contact": describe(c.contact, &problem.primitive_index)}),
     );

@@ -53,10 +53,10 @@ fuzz_target!(|data: &[u8]| {
         Err(Error::NonFiniteJoint { joint }) => assert!(config_ok && !q[usize::from(joint)].is_finite()),
         Err(e) => panic!("unexpected state error {e:?}"),
     };
-    let end = check_end(&scene, &traj[0], &config);
+    let end = check_end(&edmp_core::robot::PANDA, &scene, &traj[0], &config);
     expect_state(end, &traj[0]);
-    expect_state(check_state(&scene, &traj[2], &config), &traj[2]);
-    expect_state(check_end(&scene, &traj[2], &config), &traj[2]);
+    expect_state(check_state(&edmp_core::robot::PANDA, &scene, &traj[2], &config), &traj[2]);
+    expect_state(check_end(&edmp_core::robot::PANDA, &scene, &traj[2], &config), &traj[2]);
 
     // Segments are taken in order: the first whose joint difference is not finite is
     // `NonFiniteJoint` (also for finite waypoints whose difference overflows), the first too
@@ -79,8 +79,8 @@ fuzz_target!(|data: &[u8]| {
         Error::SegmentTooLong => assert!(config_ok && first_bad == Some(Error::SegmentTooLong)),
         e => panic!("unexpected trajectory error {e:?}"),
     };
-    let full = check_trajectory(&scene, &traj, &config, false);
-    let first = check_trajectory(&scene, &traj, &config, true);
+    let full = check_trajectory(&edmp_core::robot::PANDA, &scene, &traj, &config, false);
+    let first = check_trajectory(&edmp_core::robot::PANDA, &scene, &traj, &config, true);
     match (full, first) {
         (Ok(full), Ok(first)) => {
             assert!(config_ok && all_finite && steps_ok);
@@ -95,10 +95,10 @@ fuzz_target!(|data: &[u8]| {
             // every 8th), so only a state that GJK's carried direction decides at the margin can
             // make the verdicts differ: it must answer, and it agrees with a fresh check of its
             // far end, which it checks first with fresh directions.
-            let segment = check_segment(&scene, &traj[0], &traj[1], [&traj[0], &traj[2]], &config);
+            let segment = check_segment(&edmp_core::robot::PANDA, &scene, &traj[0], &traj[1], [&traj[0], &traj[2]], &config);
             assert!(segment.is_ok(), "{segment:?}");
             let near = |e: &[f32; 7]| traj[1].iter().zip(e).all(|(x, y)| (x - y).abs() <= config.end_radius);
-            if !near(&traj[0]) && !near(&traj[2]) && check_state(&scene, &traj[1], &config).is_ok_and(|c| c.is_some()) {
+            if !near(&traj[0]) && !near(&traj[2]) && check_state(&edmp_core::robot::PANDA, &scene, &traj[1], &config).is_ok_and(|c| c.is_some()) {
                 assert_eq!(segment, Ok(false));
             }
         }

@@ -118,14 +118,14 @@ fuzz_target!(|data: &[u8]| {
 
     let check = CheckConfig { self_collision: flags & 8 == 0, ..CheckConfig::default() };
     for q in trajectory.iter().take(2) {
-        match check_state(&scene, q, &check) {
+        match check_state(&edmp_core::robot::PANDA, &scene, q, &check) {
             Ok(_) => assert!(q.iter().all(|x| x.is_finite())),
             Err(Error::NonFiniteJoint { .. }) => assert!(!q.iter().all(|x| x.is_finite())),
             Err(e) => panic!("unexpected checker error {e:?}"),
         }
     }
     let short: [[f32; 7]; 2] = [trajectory[0], trajectory[1]];
-    match check_trajectory(&scene, &short, &check, true) {
+    match check_trajectory(&edmp_core::robot::PANDA, &scene, &short, &check, true) {
         // Stopping at the first contact may end after one state; a free report saw both ends.
         Ok(report) => {
             assert!(report.states >= 1 && report.colliding_states <= report.states);

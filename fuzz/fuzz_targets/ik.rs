@@ -61,7 +61,7 @@ fuzz_target!(|data: &[u8]| {
             assert!(s.position_error <= config.position_tolerance && s.rotation_error <= config.rotation_tolerance);
             assert!(s.starts_tried >= 1 && s.starts_tried <= config.starts);
             let check = CheckConfig { end_margin: config.clearance, ..CheckConfig::default() };
-            assert_eq!(check_end(&scene, &s.joints, &check), Ok(None));
+            assert_eq!(check_end(&edmp_core::robot::PANDA, &scene, &s.joints, &check), Ok(None));
         }
         Err(IkError::BadConfig) => assert!(!sane),
         Err(IkError::BadInput) => assert!(sane && !(target_ok && finite(&preferred))),

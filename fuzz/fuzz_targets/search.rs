@@ -58,7 +58,7 @@ fuzz_target!(|data: &[u8]| {
             return Err(Error::Overflow);
         }
         if use_checker {
-            check_segment(&scene, a, b, [&start, &goal], &check)
+            check_segment(&edmp_core::robot::PANDA, &scene, a, b, [&start, &goal], &check)
         } else {
             Ok(analytic_free(&boxes, a, b))
         }

@@ -61,7 +61,7 @@ fn obstacle_contacts_are_never_missed() {
         let mut scene = Scene::<1>::new();
         scene.push(obstacle(&pair.obstacle, i)).unwrap();
         let q = q32(&pair.joints);
-        let ours = check_state(&scene, &q, &cfg).unwrap();
+        let ours = check_state(&edmp_core::robot::PANDA, &scene, &q, &cfg).unwrap();
         if pair.distance <= 0.0 {
             assert!(
                 ours.is_some(),
@@ -70,7 +70,7 @@ fn obstacle_contacts_are_never_missed() {
                 pair.link
             );
             // How far apart our hulls look where PyBullet touches: what the margin must cover.
-            worst_hidden = worst_hidden.max(clearance(&scene, &q).unwrap());
+            worst_hidden = worst_hidden.max(clearance(&edmp_core::robot::PANDA, &scene, &q).unwrap());
         } else if ours.is_some() {
             false_contact += 1;
             if pair.distance > 0.01 {
@@ -98,7 +98,13 @@ fn self_contacts_are_never_missed() {
     let scene = Scene::<1>::new();
     let mut false_contact = 0;
     for (i, s) in f.self_pairs.iter().enumerate() {
-        let ours = check_state(&scene, &q32(&s.joints), &CheckConfig::default()).unwrap();
+        let ours = check_state(
+            &edmp_core::robot::PANDA,
+            &scene,
+            &q32(&s.joints),
+            &CheckConfig::default(),
+        )
+        .unwrap();
         if s.distance <= 0.0 {
             assert!(
                 ours.is_some(),
@@ -136,7 +142,7 @@ fn ends_follow_pybullets_own_rule() {
         let mut scene = Scene::<1>::new();
         scene.push(obstacle(&pair.obstacle, i)).unwrap();
         let q = q32(&pair.joints);
-        let ours = check_end(&scene, &q, &cfg).unwrap();
+        let ours = check_end(&edmp_core::robot::PANDA, &scene, &q, &cfg).unwrap();
         if pair.distance <= 0.0 {
             assert!(
                 ours.is_some(),
@@ -144,7 +150,7 @@ fn ends_follow_pybullets_own_rule() {
                 pair.distance
             );
         }
-        let gap = f64::from(clearance(&scene, &q).unwrap());
+        let gap = f64::from(clearance(&edmp_core::robot::PANDA, &scene, &q).unwrap());
         if gap > 0.0 && pair.distance.abs() < 0.01 {
             widest = widest.max(gap - pair.distance);
         }

@@ -20,7 +20,7 @@ fn ik_round_trip_on_1000_reachable_poses() {
         let q: [f32; 7] = core::array::from_fn(|j| {
             PANDA.soft_lower[j] + rng.unit_f32() * (PANDA.soft_upper[j] - PANDA.soft_lower[j])
         });
-        if check_state(&scene, &q, &CheckConfig::default()) != Ok(None) {
+        if check_state(&edmp_core::robot::PANDA, &scene, &q, &CheckConfig::default()) != Ok(None) {
             continue; // not a valid robot state, so its pose is not a fair target
         }
         tried += 1;

@@ -28,9 +28,13 @@ fn search_finds_a_checked_free_path_around_a_wall() {
     let cfg = CheckConfig::DEFAULT;
     let start: Joints<f32> = [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
     let goal: Joints<f32> = [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
-    assert_eq!(check_state(&scene, &start, &cfg), Ok(None));
-    assert_eq!(check_state(&scene, &goal, &cfg), Ok(None));
-    assert!(!check_trajectory(&scene, &[start, goal], &cfg, true).unwrap().is_free());
+    assert_eq!(check_state(&edmp_core::robot::PANDA, &scene, &start, &cfg), Ok(None));
+    assert_eq!(check_state(&edmp_core::robot::PANDA, &scene, &goal, &cfg), Ok(None));
+    assert!(
+        !check_trajectory(&edmp_core::robot::PANDA, &scene, &[start, goal], &cfg, true)
+            .unwrap()
+            .is_free()
+    );
 
     let config = SearchConfig::DEFAULT;
     let mut space = Box::new(SearchSpace::<2048>::new());
@@ -39,7 +43,7 @@ fn search_finds_a_checked_free_path_around_a_wall() {
         let mut calls = 0u64;
         let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| {
             calls += 1;
-            Ok(check_trajectory(&scene, &[*a, *b], &cfg, true)?.is_free())
+            Ok(check_trajectory(&edmp_core::robot::PANDA, &scene, &[*a, *b], &cfg, true)?.is_free())
         };
         let found = search(&start, &goal, &config, &mut space, &mut Rng::new(seed), &mut edge_free)
             .unwrap()
@@ -52,7 +56,7 @@ fn search_finds_a_checked_free_path_around_a_wall() {
         assert!(calls <= config.max_oracle_calls(2048));
         assert_eq!(found.path.len(), HORIZON);
         assert_eq!((found.path[0], found.path[HORIZON - 1]), (start, goal));
-        let whole = check_trajectory(&scene, &found.path, &cfg, false).unwrap();
+        let whole = check_trajectory(&edmp_core::robot::PANDA, &scene, &found.path, &cfg, false).unwrap();
         assert!(whole.is_free(), "seed {seed}: {whole:?}");
         first.get_or_insert(found);
     }
@@ -64,7 +68,9 @@ fn search_finds_a_checked_free_path_around_a_wall() {
         &config,
         &mut space,
         &mut Rng::new(1),
-        &mut |a: &Joints<f32>, b: &Joints<f32>| Ok(check_trajectory(&scene, &[*a, *b], &cfg, true)?.is_free()),
+        &mut |a: &Joints<f32>, b: &Joints<f32>| {
+            Ok(check_trajectory(&edmp_core::robot::PANDA, &scene, &[*a, *b], &cfg, true)?.is_free())
+        },
     )
     .unwrap()
     .unwrap();

@@ -22,7 +22,7 @@ fn configuration() -> impl Strategy<Value = [f32; 7]> {
     let ranges: [core::ops::RangeInclusive<f32>; 7] =
         core::array::from_fn(|j| PANDA.soft_lower[j] + 0.05..=PANDA.soft_upper[j] - 0.05);
     ranges.prop_filter("free of self-contact", |q| {
-        check_end(&Scene::<1>::new(), q, &CheckConfig::default()) == Ok(None)
+        check_end(&edmp_core::robot::PANDA, &Scene::<1>::new(), q, &CheckConfig::default()) == Ok(None)
     })
 }
 
@@ -60,7 +60,7 @@ fn checked(pieces: &mut [Element], q: &[f32; 7]) -> Option<Contact> {
     let used = build(&input, pieces, &mut nodes, &mut keys).unwrap();
     let surface = Surface::new(pieces, &nodes[..used]).unwrap();
     let scene = Scene::<4>::new().with_surface(surface, &[]);
-    check_end(&scene, q, &CheckConfig::default()).unwrap()
+    check_end(&edmp_core::robot::PANDA, &scene, q, &CheckConfig::default()).unwrap()
 }
 
 fn direction(theta: f32, phi: f32) -> Vector3<f32> {

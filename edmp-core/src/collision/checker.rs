@@ -9,18 +9,19 @@
 //! first and can only prove freedom: bounding balls, then the body's oriented box (which holds
 //! its hull).
 //!
-//! Checked, as docs/formats.md defines a solved problem: every moving body (links 1-7, hand,
-//! fingers, held object) against every obstacle, and every pair of bodies that are not chain
-//! neighbours (link7, hand, fingers and held object form one rigid group), at every waypoint
-//! and at every state of the linear joint interpolation in steps of at most `max_step`.
+//! Checked, as docs/formats.md defines a solved problem: every moving body of the arm (for the
+//! Panda: links 1-7, hand, fingers; the held object) against every obstacle, and every pair of
+//! the arm's self-collision table ([`Robot::self_pairs`]; the held object counts as part of
+//! the hand's link), at every waypoint and at every state of the linear joint interpolation in
+//! steps of at most `max_step`. The arm is a parameter: every entry point takes its tables.
 
 use crate::collision::convex::{Convex, Hull, Solid};
 use crate::collision::gjk::{apart_by, distance_lower_bound};
 use crate::error::Error;
 use crate::float::sqrt_below;
-use crate::robot::kinematics::{Joints, Kinematics, forward_with};
-use crate::robot::reach::{BODY_REACH, HAND_REACH, motion};
-use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
+use crate::robot::kinematics::{Kinematics, forward_with};
+use crate::robot::reach::motion;
+use crate::robot::{BODIES, MAX_BODIES, MAX_FRAMES, Robot};
 use crate::scene::{Scene, Shape};
 use crate::surface::Probe;
 use crate::surface::element::{Aabb, Element, Piece};
@@ -51,8 +52,14 @@ pub const MAX_JOINT_STEP: f32 = 0.01;
 /// Fixed budget of interpolated states per segment: the widest joint range (6.6 rad) at
 /// 0.01 rad needs 664, so only waypoints outside the limits can exceed it.
 pub const MAX_STEPS_PER_SEGMENT: u32 = 1024;
-/// Index of the held object in [`Contact`] (robot bodies use `robot::BODY_NAMES` indices).
+/// Index of the held object in a Panda's [`Contact`] (robot bodies use `robot::BODY_NAMES`
+/// indices): [`held_body`] of the Panda.
 pub const HELD_BODY: u8 = BODIES as u8;
+
+/// Index of the held object in [`Contact`] for `robot`: the one after its bodies.
+pub fn held_body<const J: usize>(robot: &Robot<f32, J>) -> u8 {
+    robot.bodies.len().min(MAX_BODIES) as u8
+}
 
 /// Checker settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -146,13 +153,13 @@ impl TrajectoryReport {
     }
 }
 
-/// How many revolute joints lie between a frame and the root: bodies whose levels differ by
-/// at most one are chain neighbours (the hand and fingers share link7's level).
-fn level(frame: usize) -> u8 {
-    let mut f = frame.min(FRAMES - 1);
+/// How many revolute joints lie between a frame and the root: the held object (rigid with the
+/// hand's frame) is checked against the bodies two or more levels away from the hand.
+fn level<const J: usize>(robot: &Robot<f32, J>, frame: usize) -> u8 {
+    let mut f = frame;
     let mut joints = 0u8;
-    for _ in 0..FRAMES {
-        let Some(spec) = PANDA.frames.get(f) else { break };
+    for _ in 0..robot.frames.len() {
+        let Some(spec) = robot.frames.get(f) else { break };
         if spec.joint.is_some() {
             joints = joints.saturating_add(1);
         }
@@ -164,16 +171,18 @@ fn level(frame: usize) -> u8 {
     joints
 }
 
-fn body_level(body: usize) -> u8 {
-    PANDA
+/// Whether robot body `b` and the held object are checked against each other.
+fn held_pair<const J: usize>(robot: &Robot<f32, J>, b: usize) -> bool {
+    robot
         .bodies
-        .get(body)
-        .map_or_else(|| level(HAND_FRAME), |b| level(b.frame))
+        .get(b)
+        .is_some_and(|body| level(robot, body.frame).abs_diff(level(robot, robot.hand_frame)) >= 2)
 }
 
-/// Whether shape `body` (a robot body, or the held object at `BODIES`) moves with the joints.
-pub(crate) fn moves(body: usize) -> bool {
-    body >= BODIES || PANDA.bodies[body].frame != 0
+/// Whether shape `body` (a robot body, or the held object after them) moves with the joints:
+/// bodies on the root frame are bolted to the mount.
+pub(crate) fn moves<const J: usize>(robot: &Robot<f32, J>, body: usize) -> bool {
+    robot.bodies.get(body).is_none_or(|b| b.frame != 0)
 }
 
 const PLACEHOLDER: Solid = Solid {
@@ -183,8 +192,9 @@ const PLACEHOLDER: Solid = Solid {
 };
 
 /// One state's shapes, placed.
-struct Placed<'a> {
-    k: &'a Kinematics<f32, JOINTS>,
+struct Placed<'a, const J: usize> {
+    robot: &'static Robot<f32, J>,
+    k: &'a Kinematics<f32, J>,
     held: Option<Solid>,
     /// Obstacle clearance for this state.
     margin: f32,
@@ -192,25 +202,35 @@ struct Placed<'a> {
     self_margin: f32,
 }
 
-impl Placed<'_> {
+impl<const J: usize> Placed<'_, J> {
+    /// Robot body `b`'s oriented box (callers pass robot bodies only; a bad index gives a point
+    /// at the origin rather than a panic).
     fn obb(&self, b: usize) -> Solid {
-        // `% BODIES`: callers pass robot bodies only; the modulo keeps the index provably in range.
-        let b = b % BODIES;
-        Solid::cuboid(&self.k.boxes[b], &PANDA.bodies[b].half_extents)
+        let half = self
+            .robot
+            .bodies
+            .get(b)
+            .map_or(Vector3::zeros(), |body| body.half_extents);
+        Solid::cuboid(&self.k.boxes[b % MAX_BODIES], &half)
     }
 
     fn hull(&self, b: usize) -> Hull<'_> {
-        let b = b % BODIES;
+        let frame = self.robot.bodies.get(b).map_or(0, |body| body.frame);
         Hull {
-            pose: &self.k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
-            points: PANDA.hull(b),
+            pose: &self.k.frames[frame % MAX_FRAMES],
+            points: self.robot.hull(b),
         }
+    }
+
+    /// Whether shape `b` is the held object (or past it).
+    fn is_held(&self, b: usize) -> bool {
+        b >= self.robot.bodies.len()
     }
 
     /// Body `b` (robot or held) proven apart from primitive `p`: the certified gap (above the
     /// margin), `None` when it is not proven.
     fn body_apart_from<P: Convex>(&self, b: usize, p: &P, hint: &mut Vector3<f32>) -> Option<f32> {
-        if b >= BODIES {
+        if self.is_held(b) {
             return match &self.held {
                 Some(h) => apart_by(h, p, self.margin, hint),
                 None => Some(f32::INFINITY),
@@ -224,11 +244,11 @@ impl Placed<'_> {
     /// more than `margin`, in closed form: the certified gap, `None` when it is not (or `p` is
     /// a triangle, or `b` the held object).
     fn ball_clear_of_box(&self, b: usize, p: &Element, margin: f32) -> Option<f32> {
-        let (Piece::Ball { center, radius }, true) = (p.piece, b < BODIES) else {
+        let (Piece::Ball { center, radius }, Some(body)) = (p.piece, self.robot.bodies.get(b)) else {
             return None;
         };
-        let pose = &self.k.boxes[b % BODIES];
-        let half = &PANDA.bodies[b % BODIES].half_extents;
+        let pose = &self.k.boxes[b % MAX_BODIES];
+        let half = &body.half_extents;
         let local = pose.rotation.tr_mul(&(center - pose.translation));
         let outside = local.abs() - half;
         let d2 = outside.map(|x| x.max(0.0)).norm_squared();
@@ -240,7 +260,7 @@ impl Placed<'_> {
     /// Bodies `a < b` proven apart: the certified gap, as [`Placed::body_apart_from`].
     fn bodies_apart(&self, a: usize, b: usize, hint: &mut Vector3<f32>) -> Option<f32> {
         let m = self.self_margin;
-        if b >= BODIES {
+        if self.is_held(b) {
             return match &self.held {
                 Some(h) => apart_by(&self.obb(a), h, m, hint).or_else(|| apart_by(&self.hull(a), h, m, hint)),
                 None => Some(f32::INFINITY),
@@ -250,8 +270,8 @@ impl Placed<'_> {
     }
 }
 
-/// Robot shapes per state: every collision body, then the held object.
-const SLOTS: usize = BODIES + 1;
+/// Robot shapes per state, at most: every collision body, then the held object.
+const SLOTS: usize = MAX_BODIES + 1;
 
 /// The separating direction last found for each pair, carried from one state of a trajectory
 /// to the next (zero: none yet).
@@ -288,7 +308,7 @@ const PAIRS: usize = SLOTS * SLOTS;
 /// How far two shapes can move relative to each other for joint steps `step`: a joint that
 /// turns both turns them together and changes nothing between them; one that turns only one
 /// moves it by its reach ([`crate::robot::reach`]).
-fn relative_motion(a: &[f32; JOINTS], b: &[f32; JOINTS], step: &Joints<f32>) -> f32 {
+fn relative_motion<const J: usize>(a: &[f32; J], b: &[f32; J], step: &[f32; J]) -> f32 {
     let mut m = 0.0f32;
     for ((ra, rb), d) in a.iter().zip(b).zip(step) {
         if !(*ra > 0.0 && *rb > 0.0) {
@@ -311,16 +331,16 @@ const CARRY_SLACK: f32 = 1e-4;
 /// shapes may still move, together, before the gap last certified for it no longer proves the
 /// margin. A pair with slack left at a state is free there without a test, and a state all of
 /// whose pairs have slack left needs no kinematics.
-struct Slack<const N: usize> {
+struct Slack<const J: usize, const N: usize> {
     obstacle: [[f32; N]; SLOTS],
     /// Per shape, against the whole surface (its nearest piece).
     surface: [f32; SLOTS],
     body: [[f32; SLOTS]; SLOTS],
     /// The state the slack was last used up to; `None`: nothing carried yet.
-    at: Option<Joints<f32>>,
+    at: Option<[f32; J]>,
 }
 
-impl<const N: usize> Slack<N> {
+impl<const J: usize, const N: usize> Slack<J, N> {
     fn new() -> Self {
         Self {
             obstacle: [[0.0; N]; SLOTS],
@@ -334,7 +354,8 @@ impl<const N: usize> Slack<N> {
 /// What stays the same for every state of one check: the obstacles and their bounding balls,
 /// the robot shapes' ball radii, the self-collision pairs, and the separating directions
 /// remembered so far.
-struct Prepared<'s, const N: usize> {
+struct Prepared<'s, const J: usize, const N: usize> {
+    robot: &'static Robot<f32, J>,
     scene: &'s Scene<'s, N>,
     config: CheckConfig,
     obstacles: [Solid; N],
@@ -345,43 +366,57 @@ struct Prepared<'s, const N: usize> {
     pair_count: usize,
     hints: Hints<N>,
     /// Per shape and joint, how far a point of the shape can be from the joint's axis.
-    reach: [[f32; JOINTS]; SLOTS],
-    slack: Slack<N>,
+    reach: [[f32; J]; SLOTS],
+    slack: Slack<J, N>,
 }
 
-impl<'s, const N: usize> Prepared<'s, N> {
-    fn new(scene: &'s Scene<'s, N>, config: &CheckConfig) -> Result<Self, Error> {
+impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
+    fn new(robot: &'static Robot<f32, J>, scene: &'s Scene<'s, N>, config: &CheckConfig) -> Result<Self, Error> {
         validate(config)?;
         let obstacles: [Solid; N] =
             core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Solid::obstacle));
         let obstacle_radius = obstacles.map(|o| o.bounding_radius());
-        let shapes = if scene.held().is_some() { SLOTS } else { BODIES };
-        let radius = core::array::from_fn(|b| match (PANDA.bodies.get(b), scene.held()) {
+        let bodies = robot.bodies.len().min(MAX_BODIES);
+        let shapes = if scene.held().is_some() { bodies + 1 } else { bodies };
+        let radius = core::array::from_fn(|b| match (robot.bodies.get(b), scene.held()) {
             (Some(body), _) => crate::float::sqrt(body.half_extents.norm_squared()),
-            (None, Some(h)) => Solid::obstacle(h).bounding_radius(),
-            (None, None) => 0.0,
+            (None, Some(h)) if b == bodies => Solid::obstacle(h).bounding_radius(),
+            _ => 0.0,
         });
         // The held object's points lie within |centre| + its ball's radius of the hand's origin.
         let held_extent = scene.held().map_or(0.0, |h| {
             (crate::float::sqrt(h.center.norm_squared()) + Solid::obstacle(h).bounding_radius()) * (1.0 + 1e-5)
         });
-        let reach = core::array::from_fn(|b| match BODY_REACH.get(b) {
+        let reach = core::array::from_fn(|b| match robot.body_reach.get(b) {
             Some(r) => *r,
-            None => HAND_REACH.map(|r| r + held_extent),
+            None => robot.hand_reach.map(|r| r + held_extent),
         });
+        // The arm's pairs (sorted), each body's pair with the held object after its own:
+        // ascending `(a, b)`, the order contacts are looked for in.
         let mut pairs = [(0u8, 0u8); PAIRS];
         let mut pair_count = 0;
-        for a in 0..shapes {
-            for b in a + 1..shapes {
-                if body_level(a).abs_diff(body_level(b)) >= 2
-                    && let Some(slot) = pairs.get_mut(pair_count)
-                {
-                    *slot = (a as u8, b as u8);
-                    pair_count += 1;
+        let mut push = |pair: (u8, u8)| {
+            if let Some(slot) = pairs.get_mut(pair_count) {
+                *slot = pair;
+                pair_count += 1;
+            }
+        };
+        let mut next = robot.self_pairs.iter().peekable();
+        for a in 0..bodies {
+            while let Some(&&(x, y)) = next.peek()
+                && usize::from(x) <= a
+            {
+                if usize::from(x) == a && usize::from(y) < bodies {
+                    push((x, y));
                 }
+                next.next();
+            }
+            if scene.held().is_some() && held_pair(robot, a) {
+                push((a as u8, bodies as u8));
             }
         }
         Ok(Self {
+            robot,
             scene,
             config: *config,
             obstacles,
@@ -404,20 +439,21 @@ impl<'s, const N: usize> Prepared<'s, N> {
     /// less the largest margin a state may need (`margin` or `end_margin`). Every "free" is
     /// still certified: by a separating direction at this state, or at an earlier one whose
     /// gap the motion since (bounded by [`crate::robot::reach`]) cannot have used up.
-    fn contact_at(&mut self, q: &Joints<f32>, margin: f32) -> Result<Option<Contact>, Error> {
+    fn contact_at(&mut self, q: &[f32; J], margin: f32) -> Result<Option<Contact>, Error> {
         let count = self.scene.obstacles().len();
         let surface = *self.scene.surface();
-        let step: Joints<f32> = match &self.slack.at {
+        let step: [f32; J] = match &self.slack.at {
             Some(last) => core::array::from_fn(|j| (q[j] - last[j]).abs()),
             // Nothing carried: every slack is still 0, so every pair is tested.
-            None => [0.0; JOINTS],
+            None => [0.0; J],
         };
         let moved: [f32; SLOTS] =
             core::array::from_fn(|b| self.reach.get(b).map_or(f32::INFINITY, |r| motion(r, &step)));
         self.slack.at = Some(*q);
         // Use up every pair's slack; only pairs left without any are tested.
         let mut untested = false;
-        for b in (0..self.shapes).filter(|&b| moves(b)) {
+        let robot = self.robot;
+        for b in (0..self.shapes).filter(|&b| moves(robot, b)) {
             for s in self.slack.obstacle[b % SLOTS].iter_mut().take(count) {
                 *s -= moved[b % SLOTS];
                 untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
@@ -439,15 +475,19 @@ impl<'s, const N: usize> Prepared<'s, N> {
         if !untested {
             return Ok(None);
         }
-        let k = forward_with(&PANDA, q, self.scene.gripper())?;
+        let k = forward_with(robot, q, self.scene.gripper())?;
         let self_margin = self.config.self_margin;
         let carry = self.config.margin.max(self.config.end_margin) + CARRY_SLACK;
         let carry_self = self_margin + CARRY_SLACK;
-        let held = self.scene.held().map(|h| Solid::attached(h, &k.frames[HAND_FRAME]));
-        let center: [Vector3<f32>; SLOTS] = core::array::from_fn(|b| match (k.boxes.get(b), &held) {
-            (Some(pose), _) => pose.translation,
-            (None, Some(h)) => h.center,
-            (None, None) => Vector3::zeros(),
+        let held = self
+            .scene
+            .held()
+            .map(|h| Solid::attached(h, &k.frames[robot.hand_frame % MAX_FRAMES]));
+        let bodies = robot.bodies.len();
+        let center: [Vector3<f32>; SLOTS] = core::array::from_fn(|b| match (b < bodies, k.boxes.get(b), &held) {
+            (true, Some(pose), _) => pose.translation,
+            (false, _, Some(h)) => h.center,
+            _ => Vector3::zeros(),
         });
         // The balls' gap when they are apart by more than `margin`: a lower bound on the
         // distance between the shapes they hold.
@@ -457,12 +497,13 @@ impl<'s, const N: usize> Prepared<'s, N> {
             (d2 > reach * reach).then(|| sqrt_below(d2) - r1 - r2)
         };
         let placed = Placed {
+            robot,
             k: &k,
             held,
             margin,
             self_margin,
         };
-        for b in (0..self.shapes).filter(|&b| moves(b)) {
+        for b in (0..self.shapes).filter(|&b| moves(robot, b)) {
             let candidates = self
                 .obstacles
                 .iter()
@@ -490,12 +531,8 @@ impl<'s, const N: usize> Prepared<'s, N> {
             let slack = &mut self.slack.surface[b % SLOTS];
             if !surface.is_empty() && *slack <= 0.0 {
                 let hint = &mut self.hints.surface[b % SLOTS];
-                let around = match (k.boxes.get(b), &held) {
-                    (Some(pose), _) => Aabb::around_box(
-                        &pose.translation,
-                        &pose.rotation,
-                        &PANDA.bodies[b % BODIES].half_extents,
-                    ),
+                let around = match (robot.bodies.get(b), k.boxes.get(b)) {
+                    (Some(body), Some(pose)) => Aabb::around_box(&pose.translation, &pose.rotation, &body.half_extents),
                     _ => Aabb::around_ball(&center[b % SLOTS], self.radius[b % SLOTS]),
                 };
                 let gap = surface.gap(&around, margin, SURFACE_HORIZON, |probe| match probe {
@@ -545,37 +582,50 @@ impl<'s, const N: usize> Prepared<'s, N> {
 
 /// Checks one configuration away from the ends: the first contact found, or `None` when
 /// every pair is proven apart by more than its margin.
-pub fn check_state<const N: usize>(
+pub fn check_state<const J: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    q: &Joints<f32>,
+    q: &[f32; J],
     config: &CheckConfig,
 ) -> Result<Option<Contact>, Error> {
-    Prepared::new(scene, config)?.contact_at(q, config.margin)
+    Prepared::new(robot, scene, config)?.contact_at(q, config.margin)
 }
 
 /// Checks a start or goal as the user gave it: obstacles at `end_margin`, PyBullet's own
 /// contact rule (docs/formats.md, valid ends), not the planner's margin.
-pub fn check_end<const N: usize>(
+pub fn check_end<const J: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    q: &Joints<f32>,
+    q: &[f32; J],
     config: &CheckConfig,
 ) -> Result<Option<Contact>, Error> {
-    Prepared::new(scene, config)?.contact_at(q, config.end_margin)
+    Prepared::new(robot, scene, config)?.contact_at(q, config.end_margin)
 }
 
 /// A certified lower bound on the distance from the moving robot bodies' hulls (and the held
 /// object) to the nearest obstacle or surface piece: zero when something may touch. Self-contact is not counted; for
 /// diagnostics and for choosing among states that are all free.
-pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f32, Error> {
-    let k = forward_with(&PANDA, q, scene.gripper())?;
-    let held = scene.held().map(|h| Solid::attached(h, &k.frames[HAND_FRAME]));
+pub fn clearance<const J: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
+    scene: &Scene<N>,
+    q: &[f32; J],
+) -> Result<f32, Error> {
+    let k = forward_with(robot, q, scene.gripper())?;
+    let held = scene
+        .held()
+        .map(|h| Solid::attached(h, &k.frames[robot.hand_frame % MAX_FRAMES]));
+    let placed = Placed {
+        robot,
+        k: &k,
+        held: None,
+        margin: 0.0,
+        self_margin: 0.0,
+    };
+    let moving = || (0..robot.bodies.len().min(MAX_BODIES)).filter(|&b| moves(robot, b));
     let mut best = f32::INFINITY;
     for o in scene.obstacles().iter().map(Solid::obstacle) {
-        for b in (0..BODIES).filter(|&b| moves(b)) {
-            let hull = Hull {
-                pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
-                points: PANDA.hull(b),
-            };
+        for b in moving() {
+            let hull = placed.hull(b);
             best = best.min(distance_lower_bound(&hull, &o));
         }
         if let Some(h) = &held {
@@ -583,13 +633,11 @@ pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f3
         }
     }
     let surface = scene.surface();
-    for b in (0..BODIES).filter(|&b| moves(b)) {
-        let hull = Hull {
-            pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
-            points: PANDA.hull(b),
-        };
-        let pose = &k.boxes[b];
-        let around = Aabb::around_box(&pose.translation, &pose.rotation, &PANDA.bodies[b].half_extents);
+    for b in moving() {
+        let hull = placed.hull(b);
+        let pose = &k.boxes[b % MAX_BODIES];
+        let half = robot.bodies.get(b).map_or(Vector3::zeros(), |body| body.half_extents);
+        let around = Aabb::around_box(&pose.translation, &pose.rotation, &half);
         let gap = surface.gap(&around, f32::INFINITY, best, |probe| match probe {
             Probe::Piece(e) => Some(distance_lower_bound(&hull, e)),
             Probe::Box(_) => None,
@@ -612,13 +660,14 @@ pub fn clearance<const N: usize>(scene: &Scene<N>, q: &Joints<f32>) -> Result<f3
 /// `end_margin` from obstacles, the rest `margin`). With `stop_at_first`, returns at the first
 /// contact (the report then counts states only up to it); otherwise counts every colliding
 /// state.
-pub fn check_trajectory<const H: usize, const N: usize>(
+pub fn check_trajectory<const J: usize, const H: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    trajectory: &[Joints<f32>; H],
+    trajectory: &[[f32; J]; H],
     config: &CheckConfig,
     stop_at_first: bool,
 ) -> Result<TrajectoryReport, Error> {
-    check_between_own_ends(scene, trajectory, config, stop_at_first, None)
+    check_between_own_ends(robot, scene, trajectory, config, stop_at_first, None)
 }
 
 /// [`check_trajectory`] stopping at the first contact, in the order where a candidate of the
@@ -629,19 +678,21 @@ pub fn check_trajectory<const H: usize, const N: usize>(
 /// are the same as [`check_trajectory`]'s; which contact is reported first differs, and so
 /// may, rarely, the verdict on a state GJK's carried direction decides at the margin (each
 /// "free" is certified either way).
-pub fn check_trajectory_from<const H: usize, const N: usize>(
+pub fn check_trajectory_from<const J: usize, const H: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    trajectory: &[Joints<f32>; H],
+    trajectory: &[[f32; J]; H],
     config: &CheckConfig,
     first: usize,
 ) -> Result<TrajectoryReport, Error> {
-    check_between_own_ends(scene, trajectory, config, true, Some(first))
+    check_between_own_ends(robot, scene, trajectory, config, true, Some(first))
 }
 
 /// [`check_path`] of a whole trajectory, whose first and last waypoints are the ends.
-fn check_between_own_ends<const N: usize>(
+fn check_between_own_ends<const J: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    trajectory: &[Joints<f32>],
+    trajectory: &[[f32; J]],
     config: &CheckConfig,
     stop_at_first: bool,
     first: Option<usize>,
@@ -653,7 +704,7 @@ fn check_between_own_ends<const N: usize>(
             first_contact: None,
         });
     };
-    check_path(scene, trajectory, [start, end], config, stop_at_first, first)
+    check_path(robot, scene, trajectory, [start, end], config, stop_at_first, first)
 }
 
 /// Checks the straight segment `a → b` (both ends included) of a path whose ends are `ends`
@@ -664,14 +715,15 @@ fn check_between_own_ends<const N: usize>(
 /// already known free and its `b` the new step, so an edge that collides mostly does so at
 /// `b`, which one state then proves; a shortcut between two free waypoints collides somewhere
 /// inside, which the coarse pass finds in an eighth of the states.
-pub fn check_segment<const N: usize>(
+pub fn check_segment<const J: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    a: &Joints<f32>,
-    b: &Joints<f32>,
-    ends: [&Joints<f32>; 2],
+    a: &[f32; J],
+    b: &[f32; J],
+    ends: [&[f32; J]; 2],
     config: &CheckConfig,
 ) -> Result<bool, Error> {
-    let mut prepared = Prepared::new(scene, config)?;
+    let mut prepared = Prepared::new(robot, scene, config)?;
     let steps = segment_steps(a, b, config.max_step)?;
     if prepared.contact_at(b, margin_at(b, ends, config))?.is_some() {
         return Ok(false);
@@ -692,7 +744,7 @@ pub fn check_segment<const N: usize>(
 const COARSE_STRIDE: usize = 8;
 
 /// The obstacle clearance state `q` must keep: `end_margin` near an end, `margin` elsewhere.
-fn margin_at(q: &Joints<f32>, ends: [&Joints<f32>; 2], config: &CheckConfig) -> f32 {
+fn margin_at<const J: usize>(q: &[f32; J], ends: [&[f32; J]; 2], config: &CheckConfig) -> f32 {
     if ends.iter().any(|e| within(q, e, config.end_radius)) {
         config.end_margin
     } else {
@@ -701,19 +753,20 @@ fn margin_at(q: &Joints<f32>, ends: [&Joints<f32>; 2], config: &CheckConfig) -> 
 }
 
 /// Whether `q` lies within `radius` (max-norm) of `end`.
-fn within(q: &Joints<f32>, end: &Joints<f32>, radius: f32) -> bool {
+fn within<const J: usize>(q: &[f32; J], end: &[f32; J], radius: f32) -> bool {
     q.iter().zip(end.iter()).all(|(x, y)| (x - y).abs() <= radius)
 }
 
-fn check_path<const N: usize>(
+fn check_path<const J: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    trajectory: &[Joints<f32>],
-    ends: [&Joints<f32>; 2],
+    trajectory: &[[f32; J]],
+    ends: [&[f32; J]; 2],
     config: &CheckConfig,
     stop_at_first: bool,
     first: Option<usize>,
 ) -> Result<TrajectoryReport, Error> {
-    let mut prepared = Prepared::new(scene, config)?;
+    let mut prepared = Prepared::new(robot, scene, config)?;
     let mut report = TrajectoryReport {
         states: 0,
         colliding_states: 0,
@@ -773,7 +826,7 @@ fn check_path<const N: usize>(
 }
 
 /// Number of states (the start included, the end excluded) that keep every joint step ≤ `max_step`.
-fn segment_steps(a: &Joints<f32>, b: &Joints<f32>, max_step: f32) -> Result<u32, Error> {
+fn segment_steps<const J: usize>(a: &[f32; J], b: &[f32; J], max_step: f32) -> Result<u32, Error> {
     let mut widest = 0.0f32;
     for (x, y) in a.iter().zip(b.iter()) {
         let d = (y - x).abs();
@@ -789,15 +842,16 @@ fn segment_steps(a: &Joints<f32>, b: &Joints<f32>, max_step: f32) -> Result<u32,
     Ok(steps as u32)
 }
 
-fn interpolate(a: &Joints<f32>, b: &Joints<f32>, step: u32, steps: u32) -> Joints<f32> {
+fn interpolate<const J: usize>(a: &[f32; J], b: &[f32; J], step: u32, steps: u32) -> [f32; J] {
     let t = step as f32 / steps as f32;
-    core::array::from_fn(|j| if j < JOINTS { a[j] + (b[j] - a[j]) * t } else { a[j] })
+    core::array::from_fn(|j| a[j] + (b[j] - a[j]) * t)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::robot::kinematics::forward;
+    use crate::robot::kinematics::{Joints, forward};
+    use crate::robot::{HAND_FRAME, PANDA};
     use crate::scene::Obstacle;
 
     const READY: [f32; 7] = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
@@ -823,27 +877,37 @@ mod tests {
         let config = CheckConfig::default();
         for w in [0.04, 0.025, 0.015] {
             let open = scene.clone().with_gripper(w).unwrap();
-            assert_eq!(check_state(&open, &READY, &config), Ok(None), "{w}");
-            assert!(clearance(&open, &READY).unwrap() > 0.0, "{w}");
+            assert_eq!(
+                check_state(&crate::robot::PANDA, &open, &READY, &config),
+                Ok(None),
+                "{w}"
+            );
+            assert!(clearance(&crate::robot::PANDA, &open, &READY).unwrap() > 0.0, "{w}");
         }
         let closed = scene.with_gripper(0.0).unwrap();
-        let contact = check_state(&closed, &READY, &config).unwrap();
+        let contact = check_state(&crate::robot::PANDA, &closed, &READY, &config).unwrap();
         let finger = |b: u8| crate::robot::BODY_NAMES[usize::from(b)].ends_with("finger");
         assert!(
             matches!(contact, Some(Contact::Obstacle { body, obstacle: 0 }) if finger(body)),
             "{contact:?}"
         );
-        assert_eq!(check_end(&closed, &READY, &config).unwrap(), contact);
-        assert_eq!(clearance(&closed, &READY), Ok(0.0));
+        assert_eq!(
+            check_end(&crate::robot::PANDA, &closed, &READY, &config).unwrap(),
+            contact
+        );
+        assert_eq!(clearance(&crate::robot::PANDA, &closed, &READY), Ok(0.0));
         // A trajectory that stays put collides at every state, the first at once.
-        let report = check_trajectory(&closed, &[READY; 3], &config, false).unwrap();
+        let report = check_trajectory(&crate::robot::PANDA, &closed, &[READY; 3], &config, false).unwrap();
         assert_eq!(report.colliding_states, report.states);
     }
 
     #[test]
     fn ready_pose_in_an_empty_scene_is_free() {
         let scene = Scene::<4>::new();
-        assert_eq!(check_state(&scene, &READY, &CheckConfig::default()), Ok(None));
+        assert_eq!(
+            check_state(&crate::robot::PANDA, &scene, &READY, &CheckConfig::default()),
+            Ok(None)
+        );
     }
 
     #[test]
@@ -855,14 +919,17 @@ mod tests {
         scene
             .push(Obstacle::cuboid(hand.into(), [0.05; 3], ID).unwrap())
             .unwrap();
-        let contact = check_state(&scene, &READY, &CheckConfig::default()).unwrap();
+        let contact = check_state(&crate::robot::PANDA, &scene, &READY, &CheckConfig::default()).unwrap();
         assert!(
             matches!(contact, Some(Contact::Obstacle { obstacle: 0, .. })),
             "{contact:?}"
         );
         let mut far = Scene::<4>::new();
         far.push(Obstacle::sphere([2.0, 2.0, 2.0], 0.1).unwrap()).unwrap();
-        assert_eq!(check_state(&far, &READY, &CheckConfig::default()), Ok(None));
+        assert_eq!(
+            check_state(&crate::robot::PANDA, &far, &READY, &CheckConfig::default()),
+            Ok(None)
+        );
     }
 
     #[test]
@@ -873,7 +940,10 @@ mod tests {
         scene
             .push(Obstacle::cuboid([0.0, 0.0, -0.01], [0.3, 0.3, 0.02], ID).unwrap())
             .unwrap();
-        assert_eq!(check_state(&scene, &READY, &CheckConfig::default()), Ok(None));
+        assert_eq!(
+            check_state(&crate::robot::PANDA, &scene, &READY, &CheckConfig::default()),
+            Ok(None)
+        );
     }
 
     #[test]
@@ -930,7 +1000,7 @@ mod tests {
                 });
                 q
             });
-            let carried = check_trajectory(&scene, &walk, &cfg, false).unwrap();
+            let carried = check_trajectory(&crate::robot::PANDA, &scene, &walk, &cfg, false).unwrap();
             let mut afresh = 0;
             let mut count = 0;
             for pair in walk.windows(2) {
@@ -938,11 +1008,19 @@ mod tests {
                 for step in 0..steps {
                     count += 1;
                     let state = interpolate(&pair[0], &pair[1], step, steps);
-                    afresh += u32::from(check_state(&scene, &state, &cfg).unwrap().is_some());
+                    afresh += u32::from(
+                        check_state(&crate::robot::PANDA, &scene, &state, &cfg)
+                            .unwrap()
+                            .is_some(),
+                    );
                 }
             }
             count += 1;
-            afresh += u32::from(check_state(&scene, &walk[5], &cfg).unwrap().is_some());
+            afresh += u32::from(
+                check_state(&crate::robot::PANDA, &scene, &walk[5], &cfg)
+                    .unwrap()
+                    .is_some(),
+            );
             assert_eq!(carried.states, count);
             assert_eq!(carried.colliding_states, afresh, "walk {walk:?}");
             states += count;
@@ -967,9 +1045,9 @@ mod tests {
             .push(Obstacle::cuboid([0.6, 0.0, 0.5], [0.4, 0.005, 0.4], ID).unwrap())
             .unwrap();
         let cfg = CheckConfig::default();
-        assert_eq!(check_state(&scene, &a, &cfg), Ok(None));
-        assert_eq!(check_state(&scene, &b, &cfg), Ok(None));
-        let report = check_trajectory(&scene, &[a, b], &cfg, false).unwrap();
+        assert_eq!(check_state(&crate::robot::PANDA, &scene, &a, &cfg), Ok(None));
+        assert_eq!(check_state(&crate::robot::PANDA, &scene, &b, &cfg), Ok(None));
+        let report = check_trajectory(&crate::robot::PANDA, &scene, &[a, b], &cfg, false).unwrap();
         assert!(!report.is_free());
         // 2.4 rad at 0.01 rad: 240 steps (241 after f32 rounding of the quotient) plus the end.
         assert!((241..=242).contains(&report.states), "{}", report.states);
@@ -990,14 +1068,14 @@ mod tests {
             .push(Obstacle::cuboid([0.6, 0.0, 0.5], [0.4, 0.005, 0.4], ID).unwrap())
             .unwrap();
         let cfg = CheckConfig::default();
-        let plain = check_trajectory(&scene, &path, &cfg, true).unwrap();
+        let plain = check_trajectory(&crate::robot::PANDA, &scene, &path, &cfg, true).unwrap();
         let hit = plain.first_contact.expect("the swing touches the wall").segment;
         for first in 0..14 {
-            let from = check_trajectory_from(&scene, &path, &cfg, first).unwrap();
+            let from = check_trajectory_from(&crate::robot::PANDA, &scene, &path, &cfg, first).unwrap();
             assert!(!from.is_free(), "from segment {first}");
             assert_eq!(from.colliding_states, 1, "it stops at the first contact");
         }
-        let at_contact = check_trajectory_from(&scene, &path, &cfg, usize::from(hit)).unwrap();
+        let at_contact = check_trajectory_from(&crate::robot::PANDA, &scene, &path, &cfg, usize::from(hit)).unwrap();
         assert!(
             at_contact.states < plain.states,
             "{} vs {}",
@@ -1011,10 +1089,13 @@ mod tests {
         );
         let free: [Joints<f32>; 11] =
             core::array::from_fn(|i| core::array::from_fn(|j| c[j] + (d[j] - c[j]) * i as f32 / 10.0));
-        let whole = check_trajectory(&scene, &free, &cfg, true).unwrap();
+        let whole = check_trajectory(&crate::robot::PANDA, &scene, &free, &cfg, true).unwrap();
         assert!(whole.is_free());
         for first in [0, 4, 10] {
-            assert_eq!(check_trajectory_from(&scene, &free, &cfg, first).unwrap(), whole);
+            assert_eq!(
+                check_trajectory_from(&crate::robot::PANDA, &scene, &free, &cfg, first).unwrap(),
+                whole
+            );
         }
     }
 
@@ -1023,7 +1104,13 @@ mod tests {
     fn self_contact_when_the_hand_folds_onto_the_base() {
         // Joint 4 at its lower limit with joint 2 forward folds link7/hand towards link1-2.
         let folded = [0.0, 1.7, 0.0, -3.07, 0.0, 0.0, 0.0];
-        let contact = check_state(&Scene::<1>::new(), &folded, &CheckConfig::default()).unwrap();
+        let contact = check_state(
+            &crate::robot::PANDA,
+            &Scene::<1>::new(),
+            &folded,
+            &CheckConfig::default(),
+        )
+        .unwrap();
         assert!(matches!(contact, Some(Contact::SelfContact { .. })), "{contact:?}");
     }
 
@@ -1036,9 +1123,12 @@ mod tests {
         let tip = hand.transform_point(&Vector3::new(0.0, 0.0, 0.38));
         let mut scene = Scene::<4>::new();
         scene.push(Obstacle::sphere(tip.into(), 0.03).unwrap()).unwrap();
-        assert_eq!(check_state(&scene, &READY, &CheckConfig::default()), Ok(None));
+        assert_eq!(
+            check_state(&crate::robot::PANDA, &scene, &READY, &CheckConfig::default()),
+            Ok(None)
+        );
         scene.hold(Obstacle::cuboid([0.0, 0.0, 0.2], [0.02, 0.02, 0.3], ID).unwrap());
-        let contact = check_state(&scene, &READY, &CheckConfig::default()).unwrap();
+        let contact = check_state(&crate::robot::PANDA, &scene, &READY, &CheckConfig::default()).unwrap();
         assert_eq!(
             contact,
             Some(Contact::Obstacle {
@@ -1055,11 +1145,20 @@ mod tests {
             margin: -1.0,
             ..CheckConfig::default()
         };
-        assert_eq!(check_state(&scene, &READY, &cfg), Err(Error::BadParameter));
+        assert_eq!(
+            check_state(&crate::robot::PANDA, &scene, &READY, &cfg),
+            Err(Error::BadParameter)
+        );
         let mut far = READY;
         far[0] = 100.0;
         assert_eq!(
-            check_trajectory(&scene, &[READY, far], &CheckConfig::default(), true),
+            check_trajectory(
+                &crate::robot::PANDA,
+                &scene,
+                &[READY, far],
+                &CheckConfig::default(),
+                true
+            ),
             Err(Error::SegmentTooLong)
         );
     }

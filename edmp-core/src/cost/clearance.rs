@@ -124,7 +124,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
                     }
                 }
             };
-            for b in (0..BODIES).filter(|&b| moves(b)) {
+            for b in (0..BODIES).filter(|&b| moves(&crate::robot::PANDA, b)) {
                 let frame = PANDA.bodies[b].frame.min(FRAMES - 1);
                 let points = PANDA.hull(b);
                 let (hb, hc) = (

@@ -58,7 +58,7 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
     let mut calls = 0u32;
     let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| {
         calls = calls.saturating_add(1);
-        check_segment(scene, a, b, [start, goal], &config.check)
+        check_segment(&crate::robot::PANDA, scene, a, b, [start, goal], &config.check)
     };
     // The first stage's candidate with the lowest swept volume (first on ties): the one that
     // reaches least into the obstacles.

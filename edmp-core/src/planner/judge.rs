@@ -55,7 +55,7 @@ pub(crate) fn certify<E: Executor, const B: usize, const N: usize>(
             let mut judged = **x;
             clamp_for_judging(&mut judged, start, goal);
             let from = touched.map_or(0, usize::from);
-            let report = check_trajectory_from(scene, &judged, &config.check, from)?;
+            let report = check_trajectory_from(&crate::robot::PANDA, scene, &judged, &config.check, from)?;
             **done = report.is_free();
             **touched = report.first_contact.map(|c| c.segment);
             Ok(())
@@ -169,7 +169,7 @@ pub fn judge<const B: usize, const N: usize>(
             0
         } else {
             let from = touched.map_or(0, usize::from);
-            check_trajectory_from(scene, x, &config.check, from)?.colliding_states
+            check_trajectory_from(&crate::robot::PANDA, scene, x, &config.check, from)?.colliding_states
         };
         verdict.checked = true;
         verdict.free = colliding_states == 0;
@@ -212,7 +212,8 @@ pub fn rank_in_full<const B: usize, const N: usize>(req: &Request<'_, N>, plan: 
     }
     for (x, verdict) in plan.paths.iter().zip(plan.verdicts.iter_mut()) {
         if verdict.made {
-            verdict.colliding_states = check_trajectory(scene, x, &config.check, false)?.colliding_states;
+            verdict.colliding_states =
+                check_trajectory(&crate::robot::PANDA, scene, x, &config.check, false)?.colliding_states;
         }
     }
     plan.best = pick(&plan.verdicts);

@@ -91,9 +91,12 @@ pub fn shorten<const N: usize>(
         dropped: 0,
         smoothing: 0,
     };
-    let free = |p: &Path| -> Result<bool, Error> { Ok(check_trajectory(scene, p, check, true)?.is_free()) };
+    let free = |p: &Path| -> Result<bool, Error> {
+        Ok(check_trajectory(&crate::robot::PANDA, scene, p, check, true)?.is_free())
+    };
     let mut polyline = *path;
-    let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| check_segment(scene, a, b, [start, goal], check);
+    let mut edge_free =
+        |a: &Joints<f32>, b: &Joints<f32>| check_segment(&crate::robot::PANDA, scene, a, b, [start, goal], check);
     let n = greedy(&mut polyline, config.greedy_checks, &mut edge_free)?;
     let (n, _) = match polyline.get_mut(..n) {
         Some(kept) => shortcut_polyline(kept, config.attempts, rng, &mut edge_free)?,
@@ -250,7 +253,11 @@ mod tests {
         let scene = floor();
         let check = CheckConfig::default();
         let mut path = detour();
-        assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
+        assert!(
+            check_trajectory(&crate::robot::PANDA, &scene, &path, &check, true)
+                .unwrap()
+                .is_free()
+        );
         let report = shorten(
             &scene,
             [&START, &GOAL],
@@ -261,7 +268,11 @@ mod tests {
         )
         .unwrap();
         assert!(report.length_after < 0.8 * report.length_before, "{report:?}");
-        assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
+        assert!(
+            check_trajectory(&crate::robot::PANDA, &scene, &path, &check, true)
+                .unwrap()
+                .is_free()
+        );
         assert_eq!(path[0], START);
         assert_eq!(path[HORIZON - 1], GOAL);
         assert!((report.length_after - length(&path)).abs() < 1e-6);
@@ -279,10 +290,16 @@ mod tests {
             let s = i as f32 / (HORIZON - 1) as f32;
             core::array::from_fn(|j| START[j] + (GOAL[j] - START[j]) * s)
         });
-        assert!(!check_trajectory(&scene, &straight, &check, true).unwrap().is_free());
+        assert!(
+            !check_trajectory(&crate::robot::PANDA, &scene, &straight, &check, true)
+                .unwrap()
+                .is_free()
+        );
         let mut path = detour();
         assert!(
-            check_trajectory(&scene, &path, &check, true).unwrap().is_free(),
+            check_trajectory(&crate::robot::PANDA, &scene, &path, &check, true)
+                .unwrap()
+                .is_free(),
             "the detour passes the wall"
         );
         shorten(
@@ -294,7 +311,11 @@ mod tests {
             &mut path,
         )
         .unwrap();
-        assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
+        assert!(
+            check_trajectory(&crate::robot::PANDA, &scene, &path, &check, true)
+                .unwrap()
+                .is_free()
+        );
     }
 
     #[test]
@@ -320,9 +341,14 @@ mod tests {
     /// The shortening as it was before the end of the passes was checked first: every step
     /// checked in turn.
     fn step_by_step(scene: &Scene<4>, check: &CheckConfig, config: &ShortcutConfig, seed: u64, path: &mut Path) -> u8 {
-        let free = |p: &Path| check_trajectory(scene, p, check, true).unwrap().is_free();
+        let free = |p: &Path| {
+            check_trajectory(&crate::robot::PANDA, scene, p, check, true)
+                .unwrap()
+                .is_free()
+        };
         let mut rng = Rng::new(seed);
-        let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| check_segment(scene, a, b, [&START, &GOAL], check);
+        let mut edge_free =
+            |a: &Joints<f32>, b: &Joints<f32>| check_segment(&crate::robot::PANDA, scene, a, b, [&START, &GOAL], check);
         let mut polyline = *path;
         let n = greedy(&mut polyline, config.greedy_checks, &mut edge_free).unwrap();
         let (n, _) = shortcut_polyline(&mut polyline[..n], config.attempts, &mut rng, &mut edge_free).unwrap();
@@ -371,13 +397,20 @@ mod tests {
                 let bump = libm::sinf(core::f32::consts::PI * i as f32 / (HORIZON - 1) as f32);
                 q[1] -= lift * bump;
             }
-            if !check_trajectory(&scene, &path, &check, true).unwrap().is_free() {
+            if !check_trajectory(&crate::robot::PANDA, &scene, &path, &check, true)
+                .unwrap()
+                .is_free()
+            {
                 continue;
             }
             let mut reference = path;
             let kept = step_by_step(&scene, &check, &config, case, &mut reference);
             let report = shorten(&scene, [&START, &GOAL], &check, &config, &mut Rng::new(case), &mut path).unwrap();
-            assert!(check_trajectory(&scene, &path, &check, true).unwrap().is_free());
+            assert!(
+                check_trajectory(&crate::robot::PANDA, &scene, &path, &check, true)
+                    .unwrap()
+                    .is_free()
+            );
             if kept == config.smoothing {
                 assert_eq!(path, reference, "case {case}");
                 at_once += 1;

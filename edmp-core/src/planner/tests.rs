@@ -113,7 +113,7 @@ fn guided_plans_go_around_a_wall_that_the_straight_line_crosses_and_repeat_bit_f
         core::array::from_fn(|j| START[j] + s * (GOAL[j] - START[j]))
     });
     assert!(
-        !check_trajectory(&scene, &straight, &CheckConfig::default(), true)
+        !check_trajectory(&crate::robot::PANDA, &scene, &straight, &CheckConfig::default(), true)
             .unwrap()
             .is_free()
     );
@@ -234,7 +234,7 @@ fn the_global_stage_rescues_a_failed_first_stage_within_its_bound_and_repeats_bi
     let best = &a.paths[a.best];
     assert_eq!((best[0], best[HORIZON - 1]), (START, GOAL));
     assert!(
-        check_trajectory(&wall_scene(), best, &CheckConfig::default(), true)
+        check_trajectory(&crate::robot::PANDA, &wall_scene(), best, &CheckConfig::default(), true)
             .unwrap()
             .is_free()
     );
@@ -461,7 +461,7 @@ fn the_refinement_stops_on_the_checkers_word_and_keeps_certified_rows() {
     let free = |x: &Path| {
         let mut judged = *x;
         clamp_for_judging(&mut judged, &START, &GOAL);
-        check_trajectory(&scene, &judged, &CheckConfig::default(), true)
+        check_trajectory(&crate::robot::PANDA, &scene, &judged, &CheckConfig::default(), true)
             .unwrap()
             .is_free()
     };

@@ -3,7 +3,7 @@
 //! holds its arm's [`Robot`] in `f32` (`ROBOT`, what the planner uses) and `f64` (`ROBOT_F64`,
 //! for oracles and host-side tools), and its sizes and names as constants.
 
-use crate::robot::{BodySpec, FrameSpec, Gripper, Robot};
+use crate::robot::{BodySpec, FrameSpec, Gripper, Robot, reach};
 use nalgebra::{Matrix3, Vector3};
 
 // The most frames and bodies of any arm compiled in: the capacity of per-configuration
@@ -18,16 +18,18 @@ macro_rules! arm {
         pub mod $name {
             use super::*;
             include!(concat!(env!("OUT_DIR"), "/", $file));
-            /// The arm in `f32`: what the planner uses.
             // The tables are written once at f64 precision; the compiler rounds each literal
             // to f32 here. URDF numbers such as the limit -3.1416 are data, not π.
-            pub static ROBOT: Robot<f32, JOINTS> = tables!();
-            /// The same tables as a constant, for tables derived from them at compile time
-            /// ([`crate::robot::reach`]; a `static` cannot be read there).
-            #[allow(dead_code)]
-            pub(crate) const TABLES: Robot<f32, JOINTS> = tables!();
+            // The tables as a constant, without the fields derived from them: a `static`
+            // cannot be read at compile time.
+            const BASE: Robot<f32, JOINTS> = tables!(body_reach: &[], hand_reach: [0.0; JOINTS],);
+            const BODY_REACH: [[f32; JOINTS]; BODIES] = reach::body_reach(&BASE);
+            const HAND_REACH: [f32; JOINTS] = reach::frame_reach(&BASE, HAND_FRAME, 0.0);
+            /// The arm in `f32`: what the planner uses.
+            pub static ROBOT: Robot<f32, JOINTS> = tables!(body_reach: &BODY_REACH, hand_reach: HAND_REACH,);
             /// The arm in `f64`: for oracles (finite differences) and host-side tools.
-            pub static ROBOT_F64: Robot<f64, JOINTS> = tables!();
+            pub static ROBOT_F64: Robot<f64, JOINTS> =
+                tables!(body_reach: &BODY_REACH, hand_reach: HAND_REACH,);
             const _: () = assert!(FRAMES <= MAX_FRAMES && BODIES <= MAX_BODIES);
         }
     };

@@ -226,7 +226,10 @@ pub fn solve<const N: usize>(
         let Ok(Some(solution)) = descend(target, start(n, preferred), config) else {
             continue;
         };
-        if !matches!(check_end(scene, &solution.joints, &check), Ok(None)) {
+        if !matches!(
+            check_end(&crate::robot::PANDA, scene, &solution.joints, &check),
+            Ok(None)
+        ) {
             continue;
         }
         let distance: f32 = solution

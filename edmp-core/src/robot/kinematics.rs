@@ -214,7 +214,9 @@ pub fn forward_into<T: Real, const J: usize>(q: &[T; J], finger: T, out: &mut Ki
     }
     let frames = &mut out.frames;
     frames[0] = Pose::identity();
-    for (i, spec) in robot.frames.iter().enumerate().take(MAX_FRAMES).skip(1) {
+    // `get`: the tables are well formed (parents before children, within MAX_FRAMES), and the
+    // lookups say so without a panic path.
+    for (i, spec) in robot.frames.iter().enumerate().skip(1) {
         let rotation = match spec.joint.and_then(|j| q.get(j)) {
             Some(&angle) => {
                 let (s, c) = angle.sin_cos_libm();
@@ -226,12 +228,13 @@ pub fn forward_into<T: Real, const J: usize>(q: &[T; J], finger: T, out: &mut Ki
             Some(slide) => spec.translation + slide * finger,
             None => spec.translation,
         };
-        let parent = frames[spec.parent.min(i - 1)];
-        frames[i] = parent.compose(&rotation, &translation);
+        let parent = frames.get(spec.parent.min(i - 1)).copied().unwrap_or_else(Pose::identity);
+        let Some(frame) = frames.get_mut(i) else { break };
+        *frame = parent.compose(&rotation, &translation);
     }
-    let last = robot.frames.len().clamp(1, MAX_FRAMES) - 1;
     for (pose, body) in out.boxes.iter_mut().zip(robot.bodies.iter()) {
-        *pose = out.frames[body.frame.min(last)].compose(&body.rotation, &body.center);
+        let frame = out.frames.get(body.frame).copied().unwrap_or_else(Pose::identity);
+        *pose = frame.compose(&body.rotation, &body.center);
     }
     Ok(())
 }
@@ -281,7 +284,8 @@ impl<T: Real, const J: usize> Kinematics<T, J> {
                 force += g;
                 moment += c.cross(g);
             }
-            let frame = body.frame.min(last);
+            // `% MAX_FRAMES`: the frame is below `last`; the modulo says so without a panic path.
+            let frame = body.frame.min(last) % MAX_FRAMES;
             cot.force[frame] += force;
             cot.moment[frame] += moment;
         }
@@ -298,12 +302,14 @@ impl<T: Real, const J: usize> Kinematics<T, J> {
         let (mut force, mut moment) = (cot.force, cot.moment);
         let mut dq = [T::zero(); J];
         for (i, spec) in robot.frames.iter().enumerate().take(MAX_FRAMES).skip(1).rev() {
+            // `% MAX_FRAMES` (a no-op: `take`) keeps the indexing free of panic paths.
+            let i = i % MAX_FRAMES;
             if let Some(slot) = spec.joint.and_then(|j| dq.get_mut(j)) {
                 let pose = &self.frames[i];
                 let axis = pose.rotation * spec.axis;
                 *slot = axis.dot(&(moment[i] - pose.translation.cross(&force[i])));
             }
-            let parent = spec.parent.min(i - 1);
+            let parent = spec.parent.min(i.saturating_sub(1));
             let (f, m) = (force[i], moment[i]);
             force[parent] += f;
             moment[parent] += m;

@@ -103,9 +103,14 @@ pub struct Robot<T: 'static, const J: usize> {
     pub hard_upper: [T; J],
     /// The gripper, for arms with one.
     pub gripper: Option<Gripper<T>>,
+    /// Per body and joint, how far a point of the body can be from the joint's axis, in `f32`
+    /// whatever `T` ([`reach::body_reach`]: the exact checker's carried clearance).
+    pub body_reach: &'static [[f32; J]],
+    /// Per joint, how far the hand frame's origin can be from the joint's axis: a held object's
+    /// points are at most this plus their distance from the hand's origin.
+    pub hand_reach: [f32; J],
 }
 
-pub(crate) use arms::panda::TABLES as PANDA_TABLES;
 pub use arms::panda::{
     BODIES, BODY_NAMES, FINGER_OPENING_DEFAULT, FINGER_OPENING_MAX, FINGER_OPENING_MIN, FRAME_NAMES, FRAMES,
     HAND_FRAME, HULL_POINTS, JOINT_NAMES, JOINTS, TCP_FRAME,
@@ -237,5 +242,41 @@ mod tests {
         );
         assert_eq!(FRAME_NAMES[HAND_FRAME], "panda_hand");
         assert!(PANDA.is_ancestor(1, TCP_FRAME) && !PANDA.is_ancestor(10, TCP_FRAME));
+    }
+
+    /// The checker merges the held object's pairs into the arm's table by walking it once: the
+    /// table must be ascending, each pair `(a, b)` with `a < b` below the body count.
+    fn assert_pair_table<T, const J: usize>(robot: &Robot<T, J>) {
+        let n = robot.bodies.len();
+        for w in robot.self_pairs.windows(2) {
+            assert!(w[0] < w[1], "{}: {:?} before {:?}", robot.name, w[0], w[1]);
+        }
+        for &(a, b) in robot.self_pairs {
+            assert!(a < b && usize::from(b) < n, "{}: pair {a}, {b}", robot.name);
+        }
+    }
+
+    #[test]
+    fn the_self_pair_tables_are_ascending_and_the_pandas_are_its_chain_levels_rule() {
+        assert_pair_table(&PANDA);
+        // The Panda's rule: bodies two or more revolute joints apart (link7, hand and fingers
+        // share a level), as the checker used to derive it.
+        let level = |frame: usize| {
+            let (mut f, mut n) = (frame, 0);
+            while f != 0 {
+                n += usize::from(PANDA.frames[f].joint.is_some());
+                f = PANDA.frames[f].parent;
+            }
+            n
+        };
+        let mut expected = std::vec::Vec::new();
+        for a in 0..BODIES {
+            for b in a + 1..BODIES {
+                if level(PANDA.bodies[a].frame).abs_diff(level(PANDA.bodies[b].frame)) >= 2 {
+                    expected.push((a as u8, b as u8));
+                }
+            }
+        }
+        assert_eq!(PANDA.self_pairs, &expected[..]);
     }
 }

@@ -8,26 +8,16 @@
 //! `q` to `q'` the point therefore moves at most `Σ_j |q'_j − q_j| · reach_j`: a body certified
 //! `g` clear of a fixed obstacle at `q` is still more than `g − that` clear at `q'`.
 //!
-//! The tables are computed at compile time from the generated robot tables; square roots are
-//! rounded up, so every entry bounds the true length from above.
+//! The tables are computed at compile time from each arm's generated tables
+//! ([`crate::robot::arms`] stores them as [`Robot::body_reach`] and [`Robot::hand_reach`]);
+//! square roots are rounded up, so every entry bounds the true length from above.
 
-use crate::robot::PANDA_TABLES as TABLES;
-use crate::robot::{
-    BODIES, BodySpec, FINGER_OPENING_MAX, FINGER_OPENING_MIN, FRAMES, FrameSpec, HAND_FRAME, HULL_POINTS, JOINTS,
-};
+use crate::robot::{BodySpec, FrameSpec, Robot};
 use nalgebra::Vector3;
-
-/// Per body and joint: how far any point of the body can be from the joint's axis (metres;
-/// 0 where the joint does not move the body).
-pub const BODY_REACH: [[f32; JOINTS]; BODIES] = body_reach();
-
-/// Per joint: how far the hand frame's origin can be from the joint's axis (metres). A held
-/// object's points are at most this plus their distance from the hand's origin.
-pub const HAND_REACH: [f32; JOINTS] = frame_reach(HAND_FRAME, 0.0);
 
 /// Upper bound on how far any point of a shape with the per-joint `reach` moves for joint
 /// steps `step` (`|q'_j − q_j|`).
-pub fn motion(reach: &[f32; JOINTS], step: &[f32; JOINTS]) -> f32 {
+pub fn motion<const J: usize>(reach: &[f32; J], step: &[f32; J]) -> f32 {
     let mut m = 0.0f32;
     for (r, d) in reach.iter().zip(step) {
         m += r * d;
@@ -56,40 +46,45 @@ const fn norm_above(v: &Vector3<f32>) -> f32 {
 }
 
 /// The most a frame's origin can sit from its parent's: its offset, and a finger's slide at the
-/// widest opening.
-const fn offset_above(spec: &FrameSpec<f32>) -> f32 {
-    let slide = match &spec.slide {
-        Some(s) => {
-            let w = if FINGER_OPENING_MAX.abs() > FINGER_OPENING_MIN.abs() {
-                FINGER_OPENING_MAX.abs()
+/// widest opening of the arm's gripper.
+const fn offset_above<const J: usize>(robot: &Robot<f32, J>, spec: &FrameSpec<f32>) -> f32 {
+    let slide = match (&spec.slide, &robot.gripper) {
+        (Some(s), Some(g)) => {
+            let w = if g.upper.abs() > g.lower.abs() {
+                g.upper.abs()
             } else {
-                FINGER_OPENING_MIN.abs()
+                g.lower.abs()
             };
             norm_above(s) * w
         }
-        None => 0.0,
+        _ => 0.0,
     };
     norm_above(&spec.translation) + slide
 }
 
-/// Per joint: the reach of a point `local` metres from frame `frame`'s origin.
-const fn frame_reach(frame: usize, local: f32) -> [f32; JOINTS] {
-    let mut reach = [0.0f32; JOINTS];
+/// Per joint: the reach of a point `local` metres from frame `frame`'s origin (metres; 0 where
+/// the joint does not move the frame).
+pub const fn frame_reach<const J: usize>(robot: &Robot<f32, J>, frame: usize, local: f32) -> [f32; J] {
+    let mut reach = [0.0f32; J];
+    let frames = robot.frames.len();
+    if frames == 0 {
+        return reach;
+    }
     let mut d = local;
-    let mut f = if frame < FRAMES { frame } else { FRAMES - 1 };
+    let mut f = if frame < frames { frame } else { frames - 1 };
     let mut steps = 0;
-    while steps < FRAMES {
-        let spec = &TABLES.frames[f];
+    while steps < frames {
+        let spec = &robot.frames[f];
         // Joint `j` turns frame `f` (and everything below it) about an axis through f's origin.
         if let Some(j) = spec.joint
-            && j < JOINTS
+            && j < J
         {
             reach[j] = d;
         }
         if f == 0 || spec.parent >= f {
             break;
         }
-        d += offset_above(spec);
+        d += offset_above(robot, spec);
         f = spec.parent;
         steps += 1;
     }
@@ -97,11 +92,11 @@ const fn frame_reach(frame: usize, local: f32) -> [f32; JOINTS] {
 }
 
 /// The farthest hull point of `body` from its frame's origin.
-const fn hull_radius(body: &BodySpec<f32>) -> f32 {
+const fn hull_radius<const J: usize>(robot: &Robot<f32, J>, body: &BodySpec<f32>) -> f32 {
     let mut best = 0.0f32;
     let mut i = body.hull_start;
-    while i < body.hull_start + body.hull_len && i < HULL_POINTS {
-        let [x, y, z] = TABLES.hull_points[i].data.0[0];
+    while i < body.hull_start + body.hull_len && i < robot.hull_points.len() {
+        let [x, y, z] = robot.hull_points[i].data.0[0];
         let r2 = x * x + y * y + z * z;
         if r2 > best {
             best = r2;
@@ -111,12 +106,14 @@ const fn hull_radius(body: &BodySpec<f32>) -> f32 {
     sqrt_above(best)
 }
 
-const fn body_reach() -> [[f32; JOINTS]; BODIES] {
-    let mut table = [[0.0f32; JOINTS]; BODIES];
+/// Per body (the first `B` of the arm's) and joint: how far any point of the body can be from
+/// the joint's axis (metres; 0 where the joint does not move the body).
+pub const fn body_reach<const J: usize, const B: usize>(robot: &Robot<f32, J>) -> [[f32; J]; B] {
+    let mut table = [[0.0f32; J]; B];
     let mut b = 0;
-    while b < BODIES {
-        let body = &TABLES.bodies[b];
-        table[b] = frame_reach(body.frame, hull_radius(body));
+    while b < B && b < robot.bodies.len() {
+        let body = &robot.bodies[b];
+        table[b] = frame_reach(robot, body.frame, hull_radius(robot, body));
         b += 1;
     }
     table
@@ -126,8 +123,8 @@ const fn body_reach() -> [[f32; JOINTS]; BODIES] {
 mod tests {
     use super::*;
     use crate::rng::Rng;
-    use crate::robot::PANDA;
     use crate::robot::kinematics::forward;
+    use crate::robot::{HAND_FRAME, JOINTS, PANDA};
 
     #[test]
     fn no_hull_point_moves_farther_than_the_bound() {
@@ -141,7 +138,7 @@ mod tests {
                 forward(&crate::robot::PANDA, &q).unwrap(),
                 forward(&crate::robot::PANDA, &q2).unwrap(),
             );
-            for (body, reach) in BODY_REACH.iter().enumerate() {
+            for (body, reach) in PANDA.body_reach.iter().enumerate() {
                 let frame = PANDA.bodies[body].frame;
                 let step: [f32; JOINTS] = core::array::from_fn(|j| (q2[j] - q[j]).abs());
                 let bound = motion(reach, &step);
@@ -155,7 +152,7 @@ mod tests {
             }
             let hand = (a.frames[HAND_FRAME].translation - b.frames[HAND_FRAME].translation).norm();
             let step: [f32; JOINTS] = core::array::from_fn(|j| (q2[j] - q[j]).abs());
-            assert!(hand <= motion(&HAND_REACH, &step) + 1e-5);
+            assert!(hand <= motion(&PANDA.hand_reach, &step) + 1e-5);
         }
         // Not so loose that it is useless: the hand's points use a good share of it.
         assert!(worst > 0.3, "the bound is {worst} of the motion at best");
@@ -163,14 +160,12 @@ mod tests {
 
     #[test]
     fn the_base_does_not_move_and_the_hand_reaches_farthest() {
-        assert!(BODY_REACH[0].iter().all(|&r| r == 0.0));
-        assert!(BODY_REACH[1][1..].iter().all(|&r| r == 0.0) && BODY_REACH[1][0] > 0.0);
+        let reach = PANDA.body_reach;
+        assert_eq!(reach.len(), PANDA.bodies.len());
+        assert!(reach[0].iter().all(|&r| r == 0.0));
+        assert!(reach[1][1..].iter().all(|&r| r == 0.0) && reach[1][0] > 0.0);
         let hand = 8;
-        assert!((0..JOINTS).all(|j| BODY_REACH[hand][j] > 0.0));
-        assert!(
-            BODY_REACH[hand][0] > 0.5 && BODY_REACH[hand][0] < 1.5,
-            "{:?}",
-            BODY_REACH[hand]
-        );
+        assert!((0..JOINTS).all(|j| reach[hand][j] > 0.0));
+        assert!(reach[hand][0] > 0.5 && reach[hand][0] < 1.5, "{:?}", reach[hand]);
     }
 }

@@ -59,7 +59,7 @@ pub fn check_curve<const H: usize, const M: usize>(
             }
             Some(a) => {
                 report.states += 2;
-                check_segment(scene, &a, &q, [first, last], config)
+                check_segment(&crate::robot::PANDA, scene, &a, &q, [first, last], config)
             }
         }
     };
@@ -82,7 +82,7 @@ pub fn check_curve<const H: usize, const M: usize>(
     }
     if let Some(a) = pending {
         report.states += 1;
-        report.free = check_segment(scene, &a, &a, [first, last], config)?;
+        report.free = check_segment(&crate::robot::PANDA, scene, &a, &a, [first, last], config)?;
     }
     Ok(report)
 }

@@ -245,8 +245,14 @@ fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record,
     let time_ms = began.elapsed().as_secs_f64() * 1e3;
     let (status, waypoints) = match planned {
         Ok(p) => {
-            let report = check_trajectory(&parsed.scene(), &p.waypoints, &CheckConfig::DEFAULT, true)
-                .map_err(|e| Failure::Input(format!("{problem}: checker: {e}")))?;
+            let report = check_trajectory(
+                &edmp_core::robot::PANDA,
+                &parsed.scene(),
+                &p.waypoints,
+                &CheckConfig::DEFAULT,
+                true,
+            )
+            .map_err(|e| Failure::Input(format!("{problem}: checker: {e}")))?;
             let status = if report.is_free() { "success" } else { "collision" };
             (status, p.waypoints.to_vec())
         }

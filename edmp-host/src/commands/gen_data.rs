@@ -87,7 +87,7 @@ fn harvest(seed: u64) -> Harvest {
                     // reversed path is kept only if it passes on its own.
                     let mut back = p.waypoints;
                     back.reverse();
-                    match check_trajectory(&scene, &back, &CheckConfig::default(), true) {
+                    match check_trajectory(&edmp_core::robot::PANDA, &scene, &back, &CheckConfig::default(), true) {
                         Ok(r) if r.is_free() => out.trajectories.push(back),
                         _ => out.failures += 1,
                     }
@@ -196,7 +196,7 @@ mod tests {
             let h = harvest(seed);
             for (i, t) in h.trajectories.iter().enumerate() {
                 assert!(t.iter().all(|q| PANDA.within_soft_limits(q, 1e-5)));
-                let r = check_trajectory(&scene, t, &CheckConfig::default(), true).unwrap();
+                let r = check_trajectory(&edmp_core::robot::PANDA, &scene, t, &CheckConfig::default(), true).unwrap();
                 assert!(r.is_free(), "seed {seed} trajectory {i}: {r:?}");
             }
             total += h.trajectories.len();

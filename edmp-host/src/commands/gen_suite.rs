@@ -274,7 +274,7 @@ mod tests {
                         if !PANDA.within_soft_limits(q, 1e-5) {
                             return Err(format!("{name}: {end} outside the joint limits"));
                         }
-                        if check_state(&p.scene(), q, &CheckConfig::default()) != Ok(None) {
+                        if check_state(&edmp_core::robot::PANDA, &p.scene(), q, &CheckConfig::default()) != Ok(None) {
                             return Err(format!("{name}: {end} not free"));
                         }
                     }

@@ -105,7 +105,8 @@ fn quality(x: &Path, empty: &Scene<1>) -> Quality {
         self_collision: true,
         ..CheckConfig::default()
     };
-    let self_colliding = check_trajectory(empty, x, &config, true).map_or(true, |r| !r.is_free());
+    let self_colliding =
+        check_trajectory(&edmp_core::robot::PANDA, empty, x, &config, true).map_or(true, |r| !r.is_free());
     Quality {
         roughness: roughness(x),
         outside_limits,

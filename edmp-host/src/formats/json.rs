@@ -296,8 +296,8 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
             format!("in collision: {body} inside the closed mesh obstacles[{i}]"),
         ));
     }
-    if let Some(c) =
-        check_end(&scene, &start, &CheckConfig::default()).map_err(|e| InputError::at(&sp, e.to_string()))?
+    if let Some(c) = check_end(&edmp_core::robot::PANDA, &scene, &start, &CheckConfig::default())
+        .map_err(|e| InputError::at(&sp, e.to_string()))?
     {
         return Err(InputError::at(
             &sp,
@@ -316,8 +316,8 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
                     format!("in collision: {body} inside the closed mesh obstacles[{i}]"),
                 ));
             }
-            if let Some(c) =
-                check_end(&scene, &q, &CheckConfig::default()).map_err(|e| InputError::at(&path, e.to_string()))?
+            if let Some(c) = check_end(&edmp_core::robot::PANDA, &scene, &q, &CheckConfig::default())
+                .map_err(|e| InputError::at(&path, e.to_string()))?
             {
                 return Err(InputError::at(
                     &path,

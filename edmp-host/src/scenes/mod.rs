@@ -151,7 +151,7 @@ pub(crate) fn neutral(scene: &Scene<MAX_OBSTACLES>, rng: &mut Rng) -> Option<Joi
     for _ in 0..50 {
         let q: Joints<f32> =
             core::array::from_fn(|j| (NEUTRAL[j] + rng.uniform_f32(0.0, 0.25)).min(PANDA.soft_upper[j]));
-        if check_state(scene, &q, &CheckConfig::default()) == Ok(None) {
+        if check_state(&edmp_core::robot::PANDA, scene, &q, &CheckConfig::default()) == Ok(None) {
             return Some(q);
         }
     }
