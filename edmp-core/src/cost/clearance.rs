@@ -124,8 +124,9 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
                     }
                 }
             };
-            for b in (0..BODIES).filter(|&b| moves(&crate::robot::PANDA, b)) {
-                let frame = PANDA.bodies[b].frame.min(FRAMES - 1);
+            for b in (0..BODIES).filter(|&b| moves(&PANDA, b)) {
+                let Some(body) = PANDA.bodies.get(b) else { continue };
+                let frame = body.frame.min(FRAMES - 1);
                 let points = PANDA.hull(b);
                 let (hb, hc) = (
                     Hull {
@@ -137,7 +138,7 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
                         points,
                     },
                 );
-                let half = &PANDA.bodies[b].half_extents;
+                let half = &body.half_extents;
                 let (bb, bc) = (Solid::cuboid(&kb.boxes[b], half), Solid::cuboid(&kc.boxes[b], half));
                 let centers = [&kb.boxes[b].translation, &kc.boxes[b].translation];
                 segment([&hb, &hc], Some([&bb, &bc]), frame, centers, radius[b]);

@@ -228,7 +228,10 @@ pub fn forward_into<T: Real, const J: usize>(q: &[T; J], finger: T, out: &mut Ki
             Some(slide) => spec.translation + slide * finger,
             None => spec.translation,
         };
-        let parent = frames.get(spec.parent.min(i - 1)).copied().unwrap_or_else(Pose::identity);
+        let parent = frames
+            .get(spec.parent.min(i - 1))
+            .copied()
+            .unwrap_or_else(Pose::identity);
         let Some(frame) = frames.get_mut(i) else { break };
         *frame = parent.compose(&rotation, &translation);
     }
