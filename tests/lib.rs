@@ -2,7 +2,7 @@
 //! finite-difference oracle for the kinematics adjoint (also used by `fuzz/`).
 
 use edmp_core::robot::kinematics::{CORNERS, CornerGradient, forward};
-use edmp_core::robot::{BODIES, JOINTS, PANDA, PANDA_F64};
+use edmp_core::robot::{JOINTS, MAX_BODIES, PANDA, PANDA_F64};
 use nalgebra::Vector3;
 use serde::Deserialize;
 
@@ -96,7 +96,7 @@ pub fn check_adjoint(q: &[f32; JOINTS], g: &CornerGradient<f32>) -> Result<(), S
 
 /// A corner gradient with every entry zero.
 pub fn zero_gradient() -> CornerGradient<f32> {
-    [[Vector3::zeros(); CORNERS]; BODIES]
+    [[Vector3::zeros(); CORNERS]; MAX_BODIES]
 }
 
 /// An independent f64 re-implementation of EDMP's costs (straight from the definitions, no

@@ -42,15 +42,39 @@ pub struct ArmSpec {
 }
 
 /// Every arm, the Panda first.
-pub const ARMS: [ArmSpec; 1] = [ArmSpec {
-    name: "panda",
-    urdf: "weights/panda/panda.urdf",
-    tcp_link: "panda_grasptarget",
-    hand_link: "panda_hand",
-    limits: LimitSource::SafetyController,
-    gripper: true,
-    pairs: PairRule::Levels,
-}];
+pub const ARMS: [ArmSpec; 3] = [
+    ArmSpec {
+        name: "panda",
+        urdf: "weights/panda/panda.urdf",
+        tcp_link: "panda_grasptarget",
+        hand_link: "panda_hand",
+        limits: LimitSource::SafetyController,
+        gripper: true,
+        pairs: PairRule::Levels,
+    },
+    // KUKA LBR iiwa 7 (pybullet_data/kuka_iiwa): 7 revolute joints, one STL hull per link,
+    // no tool flange link, so the TCP and the hand are the last link.
+    ArmSpec {
+        name: "iiwa7",
+        urdf: "weights/iiwa7/model.urdf",
+        tcp_link: "lbr_iiwa_link_7",
+        hand_link: "lbr_iiwa_link_7",
+        limits: LimitSource::Limit,
+        gripper: false,
+        pairs: PairRule::ApartAtZero,
+    },
+    // UFACTORY xArm 6 (pybullet_data/xarm): 6 revolute joints under a geometry-free `world`
+    // root, V-HACD collision meshes (several convex pieces per link).
+    ArmSpec {
+        name: "xarm6",
+        urdf: "weights/xarm6/xarm6_robot.urdf",
+        tcp_link: "link6",
+        hand_link: "link6",
+        limits: LimitSource::Limit,
+        gripper: false,
+        pairs: PairRule::ApartAtZero,
+    },
+];
 
 /// The arm called `name`.
 pub fn arm(name: &str) -> Option<&'static ArmSpec> {

@@ -7,6 +7,7 @@
 
 pub mod arms;
 pub mod emit;
+pub mod hull_distance;
 pub mod math;
 pub mod mesh;
 pub mod prior;

@@ -1,4 +1,5 @@
-//! Collision meshes: read the vertices of a Wavefront `.obj` and fit a tight oriented box.
+//! Collision meshes: read the vertices of a Wavefront `.obj` (per convex piece) or an `.stl`, and
+//! fit a tight oriented box.
 //!
 //! The box is what the costs of EDMP use for a robot body. The original takes the mesh's
 //! axis-aligned box in the link frame; we search over orientations for the smallest volume
@@ -39,18 +40,28 @@ pub fn parse_obj_vertices(text: &str) -> Result<Vec<Vec3>, String> {
         if words.next() != Some("v") {
             continue;
         }
-        let mut v = [0.0f64; 3];
-        for slot in &mut v {
-            let word = words
-                .next()
-                .ok_or(format!("line {}: vertex with fewer than 3 coordinates", line_no + 1))?;
-            *slot = word.parse().map_err(|e| format!("line {}: {e}", line_no + 1))?;
-            if !slot.is_finite() {
-                return Err(format!("line {}: non-finite coordinate", line_no + 1));
-            }
-        }
-        vertices.push(v);
+        vertices.push(parse_coordinates(words, line_no + 1)?);
     }
+    at_least_four(vertices)
+}
+
+/// The three coordinates after a `v` (OBJ) or `vertex` (ASCII STL) keyword.
+fn parse_coordinates<'a>(mut words: impl Iterator<Item = &'a str>, line_no: usize) -> Result<Vec3, String> {
+    let mut v = [0.0f64; 3];
+    for slot in &mut v {
+        let word = words
+            .next()
+            .ok_or(format!("line {line_no}: vertex with fewer than 3 coordinates"))?;
+        *slot = word.parse().map_err(|e| format!("line {line_no}: {e}"))?;
+        if !slot.is_finite() {
+            return Err(format!("line {line_no}: non-finite coordinate"));
+        }
+    }
+    Ok(v)
+}
+
+/// A hull needs four points that are not coplanar; fewer is a broken mesh, not a body.
+fn at_least_four(vertices: Vec<Vec3>) -> Result<Vec<Vec3>, String> {
     if vertices.len() < 4 {
         return Err(format!(
             "{} vertices; a collision mesh needs at least 4",
@@ -58,6 +69,106 @@ pub fn parse_obj_vertices(text: &str) -> Result<Vec<Vec3>, String> {
         ));
     }
     Ok(vertices)
+}
+
+/// Reads the convex pieces of a collision mesh, by extension: `.obj` ([`parse_obj_pieces`]) or
+/// `.stl` ([`parse_stl_vertices`], one piece). PyBullet collides the convex hull of each piece.
+pub fn read_mesh_pieces(path: &Path) -> Result<Vec<Vec<Vec3>>, String> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let pieces = match extension.as_str() {
+        "obj" => {
+            let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            parse_obj_pieces(&text)
+        }
+        "stl" => {
+            let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            parse_stl_vertices(&bytes).map(|v| vec![v])
+        }
+        _ => Err("collision meshes must be .obj or .stl".to_owned()),
+    };
+    pieces.map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The vertices of `.obj` text, one list per convex piece: the `v` records split at each `o` or
+/// `g` statement, empty runs dropped. V-HACD writes each piece as `o convex_k` followed by its
+/// own vertices and faces, which is how PyBullet's OBJ loader splits them too (one convex hull
+/// per shape). A file with one object, whether its statement comes before or after the
+/// vertices (Blender's `g` after them), is one piece of every `v` record, as
+/// [`parse_obj_vertices`] reads it.
+pub fn parse_obj_pieces(text: &str) -> Result<Vec<Vec<Vec3>>, String> {
+    let mut pieces: Vec<Vec<Vec3>> = vec![Vec::new()];
+    for (line_no, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let v = parse_coordinates(words, line_no + 1)?;
+                if let Some(piece) = pieces.last_mut() {
+                    piece.push(v);
+                }
+            }
+            Some("o" | "g") if pieces.last().is_some_and(|p| !p.is_empty()) => pieces.push(Vec::new()),
+            _ => {}
+        }
+    }
+    pieces.retain(|p| !p.is_empty());
+    if pieces.is_empty() {
+        return Err("no vertices; a collision mesh needs at least 4".to_owned());
+    }
+    pieces
+        .into_iter()
+        .enumerate()
+        .map(|(k, p)| at_least_four(p).map_err(|e| format!("piece {k}: {e}")))
+        .collect()
+}
+
+/// The corner vertices of an `.stl` mesh, each triangle's three in file order (repeats kept, as
+/// in an OBJ's records). Binary when the size is exactly 84 bytes plus 50 per triangle the
+/// header claims (even if the header begins with `solid`), otherwise ASCII (`vertex x y z`).
+pub fn parse_stl_vertices(bytes: &[u8]) -> Result<Vec<Vec3>, String> {
+    let claimed = bytes
+        .get(80..84)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as usize);
+    let vertices = match claimed {
+        Some(n) if n.checked_mul(50).and_then(|b| b.checked_add(84)) == Some(bytes.len()) => {
+            let mut vertices = Vec::with_capacity(3 * n);
+            for t in 0..n {
+                // 12 bytes of normal, then three corners of three little-endian f32 each.
+                for corner in 0..3 {
+                    let at = 84 + 50 * t + 12 + 12 * corner;
+                    let mut v = [0.0f64; 3];
+                    for (k, slot) in v.iter_mut().enumerate() {
+                        let b = &bytes[at + 4 * k..at + 4 * k + 4];
+                        *slot = f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+                        if !slot.is_finite() {
+                            return Err(format!("byte {}: non-finite coordinate", at + 4 * k));
+                        }
+                    }
+                    vertices.push(v);
+                }
+            }
+            vertices
+        }
+        _ => {
+            let text = core::str::from_utf8(bytes)
+                .map_err(|_| "neither binary STL (size does not match the triangle count) nor ASCII".to_owned())?;
+            if !text.trim_start().starts_with("solid") {
+                return Err("neither binary STL (size does not match the triangle count) nor ASCII `solid`".to_owned());
+            }
+            let mut vertices = Vec::new();
+            for (line_no, line) in text.lines().enumerate() {
+                let mut words = line.split_whitespace();
+                if words.next() == Some("vertex") {
+                    vertices.push(parse_coordinates(words, line_no + 1)?);
+                }
+            }
+            vertices
+        }
+    };
+    at_least_four(vertices)
 }
 
 /// `points` without exact repeats, first occurrence kept (meshes repeat shared vertices).
@@ -378,6 +489,55 @@ mod tests {
                 assert!(height(&pts, f, p) <= 1e-9);
             }
         }
+    }
+
+    #[test]
+    fn splits_obj_pieces_at_objects() {
+        let text = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\no b\nv 2 0 0\nv 3 0 0\nv 2 1 0\nv 2 0 1\nv 3 1 1\nf 5 6 7\n";
+        let pieces = parse_obj_pieces(text).unwrap();
+        assert_eq!(pieces.iter().map(Vec::len).collect::<Vec<_>>(), [4, 5]);
+        assert_eq!(pieces[1][0], [2.0, 0.0, 0.0]);
+        // Blender's layout: vertices first, then the group statement and the faces: one piece.
+        let blender = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\ng mesh\nusemtl m\nf 1 2 3\n";
+        let pieces = parse_obj_pieces(blender).unwrap();
+        assert_eq!(pieces, [parse_obj_vertices(blender).unwrap()]);
+        assert!(parse_obj_pieces("o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\no b\nv 0 0 0\n").is_err());
+        assert!(parse_obj_pieces("o a\n").is_err());
+    }
+
+    fn binary_stl(triangles: &[[Vec3; 3]]) -> Vec<u8> {
+        let mut bytes = b"solid but binary".to_vec();
+        bytes.resize(80, b' ');
+        bytes.extend((triangles.len() as u32).to_le_bytes());
+        for t in triangles {
+            bytes.extend([0u8; 12]);
+            for c in t {
+                for x in c {
+                    bytes.extend((*x as f32).to_le_bytes());
+                }
+            }
+            bytes.extend([0u8; 2]);
+        }
+        bytes
+    }
+
+    #[test]
+    fn reads_binary_and_ascii_stl() {
+        let tetra = [
+            [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            [[0.0, 0.0, 0.0], [0.0, 0.0, 0.5], [1.0, 0.0, 0.0]],
+        ];
+        let binary = parse_stl_vertices(&binary_stl(&tetra)).unwrap();
+        assert_eq!(binary.len(), 6);
+        assert_eq!(binary[4], [0.0, 0.0, 0.5]);
+        let ascii = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n\
+                     facet normal 0 -1 0\nouter loop\nvertex 0 0 0\nvertex 0 0 0.5\nvertex 1 0 0\nendloop\nendfacet\nendsolid t\n";
+        assert_eq!(parse_stl_vertices(ascii.as_bytes()).unwrap(), binary);
+        // A binary file cut short is neither binary nor ASCII.
+        let mut cut = binary_stl(&tetra);
+        cut.pop();
+        assert!(parse_stl_vertices(&cut).is_err());
+        assert!(parse_stl_vertices(b"solid x\nvertex 0 0 nan\n").is_err());
     }
 
     #[test]

@@ -1,8 +1,13 @@
 //! The kinematic chain read from an arm's URDF: frames in parent-before-child order, the
-//! actuated joints with both limit sets, one collision body per link that has a collision
-//! mesh, and the self-collision pairs by the arm's rule.
+//! actuated joints with both limit sets, one collision body per convex piece of each link's
+//! collision meshes, and the self-collision pairs by the arm's rule.
+//!
+//! Body names: the link's name when the link has one piece (every Panda and iiwa link: one
+//! mesh, one hull), `LINK#k` for piece `k` (from 0, in file order) when it has several (the
+//! xArm's V-HACD pieces).
 
 use crate::arms::{ArmSpec, LimitSource, PairRule};
+use crate::hull_distance::hull_distance;
 use crate::math::{self, Mat3, Vec3};
 use crate::mesh::{self, OrientedBox};
 use std::path::{Path, PathBuf};
@@ -65,14 +70,14 @@ pub struct JointLimits {
     pub soft: [f64; 2],
 }
 
-/// A collision body: a mesh rigidly attached to a frame, and its boxes.
+/// A collision body: one convex piece of a mesh rigidly attached to a frame, and its boxes.
 #[derive(Clone, Debug)]
 pub struct Body {
-    /// URDF link name.
+    /// URDF link name, with `#k` for piece `k` of a link with several (module docs).
     pub name: String,
     /// Index of the frame the box is expressed in.
     pub frame: usize,
-    /// Mesh file, relative to the URDF's folder.
+    /// Mesh file, relative to the URDF's folder (and which piece, if it has several).
     pub mesh: String,
     /// Number of mesh vertices the boxes were fitted to.
     pub vertex_count: usize,
@@ -281,8 +286,8 @@ pub fn read_chain(path: &Path, arm: &ArmSpec) -> Result<Chain, String> {
             .iter()
             .find(|l| l.name == frame.name)
             .ok_or("link vanished")?;
-        let mut points = Vec::new();
-        let mut meshes = Vec::new();
+        // Each convex piece of each collision mesh, in the link frame, named by its file.
+        let mut pieces: Vec<(String, Vec<Vec3>)> = Vec::new();
         for collision in &link.collision {
             let urdf_rs::Geometry::Mesh { filename, scale } = &collision.geometry else {
                 return Err(format!(
@@ -290,29 +295,50 @@ pub fn read_chain(path: &Path, arm: &ArmSpec) -> Result<Chain, String> {
                     link.name
                 ));
             };
+            // `package://NAME/...` resolves to `<URDF folder>/NAME/...`: the package sits
+            // beside the URDF (weights/xarm6/xarm_description/).
             let relative = filename.strip_prefix("package://").unwrap_or(filename);
             let file = root_dir.join(relative);
             let scale = scale.map(|s| *s).unwrap_or([1.0; 3]);
             let rotation = math::rpy_to_matrix(&collision.origin.rpy);
-            for v in mesh::read_obj_vertices(&file)? {
-                let scaled = [v[0] * scale[0], v[1] * scale[1], v[2] * scale[2]];
-                points.push(math::add(&math::mul_vec(&rotation, &scaled), &collision.origin.xyz));
+            let read = mesh::read_mesh_pieces(&file).map_err(|e| format!("link `{}`: {e}", link.name))?;
+            let count = read.len();
+            for (k, piece) in read.into_iter().enumerate() {
+                let points = piece
+                    .iter()
+                    .map(|v| {
+                        let scaled = [v[0] * scale[0], v[1] * scale[1], v[2] * scale[2]];
+                        math::add(&math::mul_vec(&rotation, &scaled), &collision.origin.xyz)
+                    })
+                    .collect();
+                let name = if count == 1 {
+                    relative.to_string()
+                } else {
+                    format!("{relative} (convex piece {k} of {count})")
+                };
+                pieces.push((name, points));
             }
-            meshes.push(relative.to_string());
             inputs.push(file);
         }
-        if points.is_empty() {
-            continue;
+        // One body per piece: PyBullet collides each piece's hull on its own, and one hull
+        // around a V-HACD decomposition would fill the concavities it was made to keep.
+        let count = pieces.len();
+        for (k, (mesh_name, points)) in pieces.into_iter().enumerate() {
+            let name = if count == 1 {
+                link.name.clone()
+            } else {
+                format!("{}#{k}", link.name)
+            };
+            bodies.push(Body {
+                name,
+                frame: index,
+                mesh: mesh_name,
+                vertex_count: points.len(),
+                tight: mesh::tight_box(&points),
+                aabb: mesh::aabb(&points),
+                points: mesh::hull_vertices(&mesh::distinct(&points)),
+            });
         }
-        bodies.push(Body {
-            name: link.name.clone(),
-            frame: index,
-            mesh: meshes.join(" + "),
-            vertex_count: points.len(),
-            tight: mesh::tight_box(&points),
-            aabb: mesh::aabb(&points),
-            points: mesh::hull_vertices(&mesh::distinct(&points)),
-        });
     }
 
     let find = |name: &str| {
@@ -325,12 +351,7 @@ pub fn read_chain(path: &Path, arm: &ArmSpec) -> Result<Chain, String> {
     let hand = find(arm.hand_link)?;
     let self_pairs = match arm.pairs {
         PairRule::Levels => level_pairs(&frames, &bodies),
-        PairRule::ApartAtZero => {
-            return Err(format!(
-                "arm `{}`: the apart-at-zero pair rule is not built yet",
-                arm.name
-            ));
-        }
+        PairRule::ApartAtZero => apart_at_zero_pairs(&frames, &bodies)?,
     };
     Ok(Chain {
         arm: *arm,
@@ -373,6 +394,90 @@ fn level_pairs(frames: &[Frame], bodies: &[Body]) -> Vec<(usize, usize)> {
         }
     }
     pairs
+}
+
+/// How close (metres) two convex pieces may come at the all-zero configuration and still
+/// count as apart.
+///
+/// PyBullet inflates every convex hull it loads from a URDF by a collision margin of 1 mm
+/// (`gUrdfDefaultCollisionMargin`), so `getClosestPoints(distance = 0)` reports two hulls
+/// whose exact distance is below 2 mm as touching. The same threshold here makes the rule
+/// agree with PyBullet by construction; for the arms in [`crate::arms::ARMS`] the choice is
+/// not delicate anyway: at q = 0 the closest non-adjacent links are 31.2 mm apart (iiwa
+/// `lbr_iiwa_link_5`–`lbr_iiwa_link_7`; PyBullet reports 29.2 mm, the two margins less) and
+/// 40.8 mm (xArm `link2`–`link4`; PyBullet 38.8 mm), and `tests/tests/fk_fixture_arms.rs` compares the table with the pairs
+/// PyBullet reports.
+pub const TOUCH_DISTANCE: f64 = 0.002;
+
+/// The world pose `(rotation, translation)` of every frame at the all-zero configuration
+/// (revolute joints at 0, fingers at opening 0).
+pub fn zero_poses(frames: &[Frame]) -> Vec<(Mat3, Vec3)> {
+    let mut poses: Vec<(Mat3, Vec3)> = Vec::with_capacity(frames.len());
+    for (i, f) in frames.iter().enumerate() {
+        let pose = match poses.get(f.parent) {
+            Some((r, t)) if i > 0 => (
+                math::mul(r, &f.origin_rotation),
+                math::add(t, &math::mul_vec(r, &f.origin_translation)),
+            ),
+            _ => (math::IDENTITY, [0.0; 3]),
+        };
+        poses.push(pose);
+    }
+    poses
+}
+
+/// The rule of every arm but the Panda ([`PairRule::ApartAtZero`]): links that are not parent
+/// and child in the URDF tree and whose convex pieces are all more than [`TOUCH_DISTANCE`]
+/// apart at q = 0; every pair of their pieces is checked. Parent and child means the child's
+/// joint names the parent, as PyBullet's self-collision filter has it (it does not look
+/// through fixed joints); neither arm here has a fixed joint between two links with bodies.
+fn apart_at_zero_pairs(frames: &[Frame], bodies: &[Body]) -> Result<Vec<(usize, usize)>, String> {
+    let poses = zero_poses(frames);
+    let world: Vec<Vec<Vec3>> = bodies
+        .iter()
+        .map(|b| {
+            let (r, t) = &poses[b.frame];
+            b.points.iter().map(|p| math::add(t, &math::mul_vec(r, p))).collect()
+        })
+        .collect();
+    let adjacent = |a: usize, b: usize| frames[a].parent == b || frames[b].parent == a;
+    // Whether two links touch: their closest pieces are within TOUCH_DISTANCE.
+    let touch = |fa: usize, fb: usize| -> Result<bool, String> {
+        for (i, a) in bodies.iter().enumerate().filter(|(_, a)| a.frame == fa) {
+            for (j, b) in bodies.iter().enumerate().filter(|(_, b)| b.frame == fb) {
+                let d = hull_distance(&world[i], &world[j])
+                    .ok_or(format!("bodies `{}` and `{}`: no hull distance", a.name, b.name))?;
+                if d <= TOUCH_DISTANCE {
+                    return Ok(true);
+                }
+            }
+        }
+        Ok(false)
+    };
+    let mut apart = Vec::new();
+    let mut pairs = Vec::new();
+    for a in 0..bodies.len() {
+        for b in a + 1..bodies.len() {
+            let (fa, fb) = (bodies[a].frame, bodies[b].frame);
+            if fa == fb || adjacent(fa, fb) {
+                continue;
+            }
+            let link_pair = (fa.min(fb), fa.max(fb));
+            let known = apart.iter().find(|(pair, _)| *pair == link_pair).map(|(_, v)| *v);
+            let is_apart = match known {
+                Some(v) => v,
+                None => {
+                    let v = !touch(fa, fb)?;
+                    apart.push((link_pair, v));
+                    v
+                }
+            };
+            if is_apart {
+                pairs.push((a, b));
+            }
+        }
+    }
+    Ok(pairs)
 }
 
 fn normalised(v: &Vec3, joint: &str) -> Result<Vec3, String> {

@@ -79,7 +79,7 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             targets
                 .iter()
-                .filter(|t| solve(t, &ready, &scene, &IkConfig::default()).is_ok())
+                .filter(|t| solve(&edmp_core::robot::PANDA, t, &ready, &scene, &IkConfig::default()).is_ok())
                 .count()
         })
     });

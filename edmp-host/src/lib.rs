@@ -3,6 +3,7 @@
 //! format, which the `edmp-host` binary and the Python package both use; `scenes` generates the
 //! benchmark's scenes and `rrt` is the classical baseline. Planning math lives in `edmp-core`.
 
+pub mod arm;
 pub mod commands;
 pub mod depth;
 pub mod formats;

@@ -53,7 +53,7 @@ fuzz_target!(|data: &[u8]| {
     let target_ok = finite(rotation.as_slice())
         && finite(translation.as_slice())
         && (rotation.transpose() * rotation - Matrix3::identity()).norm() < 1e-3;
-    match solve(&target, &preferred, &scene, &config) {
+    match solve(&edmp_core::robot::PANDA, &target, &preferred, &scene, &config) {
         Ok(s) => {
             assert!(sane && target_ok && finite(&preferred));
             assert!(finite(&s.joints) && s.position_error.is_finite() && s.rotation_error.is_finite());

@@ -25,7 +25,7 @@ fn ik_round_trip_on_1000_reachable_poses() {
         }
         tried += 1;
         let target = *forward(&edmp_core::robot::PANDA, &q).unwrap().tcp();
-        let Ok(s) = solve(&target, &ready, &scene, &IkConfig::default()) else {
+        let Ok(s) = solve(&edmp_core::robot::PANDA, &target, &ready, &scene, &IkConfig::default()) else {
             continue;
         };
         let tcp = *forward(&edmp_core::robot::PANDA, &s.joints).unwrap().tcp();

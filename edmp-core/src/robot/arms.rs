@@ -41,3 +41,18 @@ arm!(
     panda,
     "robot_panda.rs"
 );
+
+#[cfg(feature = "iiwa7")]
+arm!(
+    /// The KUKA LBR iiwa 7 (`weights/iiwa7/model.urdf`), no gripper.
+    iiwa7,
+    "robot_iiwa7.rs"
+);
+
+#[cfg(feature = "xarm6")]
+arm!(
+    /// The UFACTORY xArm 6 (`weights/xarm6/xarm6_robot.urdf`), no gripper; one collision body
+    /// per convex piece of its V-HACD meshes.
+    xarm6,
+    "robot_xarm6.rs"
+);

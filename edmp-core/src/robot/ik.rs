@@ -1,10 +1,11 @@
-//! Inverse kinematics: a TCP pose to joints within the soft limits, collision-free, closest to
-//! a given configuration.
+//! Inverse kinematics for any arm: a TCP pose to joints within the planning limits,
+//! collision-free, closest to a given configuration.
 //!
 //! Damped least squares on the TCP Jacobian ([`Kinematics::tcp_jacobian`](crate::robot::kinematics::Kinematics::tcp_jacobian)) from a fixed list
 //! of starts: the preferred configuration first, then a Halton sequence over the soft limits,
 //! so the answer is deterministic and the work is bounded (`starts × iterations` FK and 6×6
-//! solves at most). Each iterate is projected back into the limits; a converged solution is
+//! solves at most). The spread starts also find the separate branches (elbow up or down, wrist
+//! flipped) of an arm without redundancy, such as a 6-joint one. Each iterate is projected back into the limits; a converged solution is
 //! kept only if the exact checker finds it free in the scene (by default PyBullet's rule for
 //! valid ends, `checker::END_MARGIN`), the fingers at the scene's opening
 //! ([`Scene::gripper`]; the TCP itself does not depend on it, so the descent runs at the default
@@ -13,8 +14,8 @@
 
 use crate::collision::checker::{CheckConfig, END_MARGIN, check_end};
 use crate::error::Error;
-use crate::robot::kinematics::{Joints, Pose, forward};
-use crate::robot::{JOINTS, PANDA};
+use crate::robot::kinematics::{Pose, forward};
+use crate::robot::{JOINTS, Robot};
 use crate::scene::Scene;
 use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3, Vector6};
 
@@ -52,11 +53,11 @@ impl Default for IkConfig {
     }
 }
 
-/// A solution and what it cost to find.
+/// A solution and what it cost to find, for an arm of `J` joints (the Panda's 7 by default).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct IkSolution {
-    /// Joints within the soft limits, collision-free in the scene.
-    pub joints: Joints<f32>,
+pub struct IkSolution<const J: usize = JOINTS> {
+    /// Joints within the planning limits, collision-free in the scene.
+    pub joints: [f32; J],
     /// Remaining TCP position error (metres).
     pub position_error: f32,
     /// Remaining TCP orientation error (radians).
@@ -132,21 +133,22 @@ fn halton(mut i: u32, base: u32) -> f32 {
     r
 }
 
-const PRIMES: [u32; JOINTS] = [2, 3, 5, 7, 11, 13, 17];
+/// One Halton base per joint (arms of up to 8 joints get distinct ones).
+const PRIMES: [u32; 8] = [2, 3, 5, 7, 11, 13, 17, 19];
 
 /// Start `n`: the preferred configuration for 0, else Halton point `n` scaled to the limits.
-fn start(n: u16, preferred: &Joints<f32>) -> Joints<f32> {
+fn start<const J: usize>(robot: &Robot<f32, J>, n: u16, preferred: &[f32; J]) -> [f32; J] {
     if n == 0 {
-        return clamp(preferred);
+        return clamp(robot, preferred);
     }
     core::array::from_fn(|j| {
-        let (lo, hi) = (PANDA.soft_lower[j], PANDA.soft_upper[j]);
-        lo + (hi - lo) * halton(u32::from(n), PRIMES[j % JOINTS])
+        let (lo, hi) = (robot.soft_lower[j], robot.soft_upper[j]);
+        lo + (hi - lo) * halton(u32::from(n), PRIMES[j % PRIMES.len()])
     })
 }
 
-fn clamp(q: &Joints<f32>) -> Joints<f32> {
-    core::array::from_fn(|j| q[j].clamp(PANDA.soft_lower[j], PANDA.soft_upper[j]))
+fn clamp<const J: usize>(robot: &Robot<f32, J>, q: &[f32; J]) -> [f32; J] {
+    core::array::from_fn(|j| q[j].clamp(robot.soft_lower[j], robot.soft_upper[j]))
 }
 
 fn valid_target(target: &Pose<f32>) -> bool {
@@ -159,9 +161,14 @@ fn valid_target(target: &Pose<f32>) -> bool {
 }
 
 /// One damped-least-squares descent from `q`; the converged configuration and its errors.
-fn descend(target: &Pose<f32>, mut q: Joints<f32>, config: &IkConfig) -> Result<Option<IkSolution>, Error> {
+fn descend<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    target: &Pose<f32>,
+    mut q: [f32; J],
+    config: &IkConfig,
+) -> Result<Option<IkSolution<J>>, Error> {
     for _ in 0..config.iterations {
-        let k = forward(&PANDA, &q)?;
+        let k = forward(robot, &q)?;
         let tcp = k.tcp();
         let dp = target.translation - tcp.translation;
         let dw = rotation_error(&target.rotation, &tcp.rotation);
@@ -178,7 +185,7 @@ fn descend(target: &Pose<f32>, mut q: Joints<f32>, config: &IkConfig) -> Result<
             }));
         }
         let rows = k.tcp_jacobian();
-        let jac = SMatrix::<f32, 6, JOINTS>::from_fn(|r, c| rows[r][c]);
+        let jac = SMatrix::<f32, 6, J>::from_fn(|r, c| rows[r][c]);
         let err = Vector6::new(dp.x, dp.y, dp.z, dw.x, dw.y, dw.z);
         let lambda2 = config.damping * config.damping;
         let jjt: Matrix6<f32> = jac * jac.transpose() + Matrix6::identity() * lambda2;
@@ -187,19 +194,20 @@ fn descend(target: &Pose<f32>, mut q: Joints<f32>, config: &IkConfig) -> Result<
         // Keep steps modest so the linearisation holds; then stay inside the limits.
         let largest = step.amax();
         let scale = if largest > 0.5 { 0.5 / largest } else { 1.0 };
-        q = clamp(&core::array::from_fn(|j| q[j] + step[j] * scale));
+        q = clamp(robot, &core::array::from_fn(|j| q[j] + step[j] * scale));
     }
     Ok(None)
 }
 
 /// Solves for joints that put the TCP at `target`, within the soft limits and collision-free
 /// in `scene` (pass an empty scene to check self-collision only), nearest `preferred`.
-pub fn solve<const N: usize>(
+pub fn solve<const J: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     target: &Pose<f32>,
-    preferred: &Joints<f32>,
+    preferred: &[f32; J],
     scene: &Scene<N>,
     config: &IkConfig,
-) -> Result<IkSolution, IkError> {
+) -> Result<IkSolution<J>, IkError> {
     let sane = config.starts > 0
         && config.iterations > 0
         && config.max_solutions > 0
@@ -219,17 +227,14 @@ pub fn solve<const N: usize>(
         end_margin: config.clearance,
         ..CheckConfig::default()
     };
-    let mut best: Option<(f32, IkSolution)> = None;
+    let mut best: Option<(f32, IkSolution<J>)> = None;
     let (mut found, mut tried) = (0u16, 0u16);
     for n in 0..config.starts {
         tried = n + 1;
-        let Ok(Some(solution)) = descend(target, start(n, preferred), config) else {
+        let Ok(Some(solution)) = descend(robot, target, start(robot, n, preferred), config) else {
             continue;
         };
-        if !matches!(
-            check_end(&crate::robot::PANDA, scene, &solution.joints, &check),
-            Ok(None)
-        ) {
+        if !matches!(check_end(robot, scene, &solution.joints, &check), Ok(None)) {
             continue;
         }
         let distance: f32 = solution
@@ -256,6 +261,7 @@ pub fn solve<const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::robot::PANDA;
 
     #[test]
     fn rotation_error_is_axis_times_angle() {
@@ -276,7 +282,14 @@ mod tests {
         let ready = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
         let target = *forward(&PANDA, &ready).unwrap().tcp();
         let preferred = [0.3, -0.5, 0.2, -2.0, 0.1, 1.8, 0.5];
-        let s = solve(&target, &preferred, &Scene::<1>::new(), &IkConfig::default()).unwrap();
+        let s = solve(
+            &crate::robot::PANDA,
+            &target,
+            &preferred,
+            &Scene::<1>::new(),
+            &IkConfig::default(),
+        )
+        .unwrap();
         let tcp = *forward(&PANDA, &s.joints).unwrap().tcp();
         assert!((tcp.translation - target.translation).norm() < 1e-3);
         assert!(rotation_error(&target.rotation, &tcp.rotation).norm() < 0.5f32.to_radians());
@@ -296,18 +309,24 @@ mod tests {
             ..IkConfig::default()
         };
         assert_eq!(
-            solve(&far, &ready, &Scene::<1>::new(), &quick),
+            solve(&crate::robot::PANDA, &far, &ready, &Scene::<1>::new(), &quick),
             Err(IkError::NoSolution)
         );
         let skew = Pose {
             rotation: Matrix3::identity() * 2.0,
             translation: Vector3::zeros(),
         };
-        assert_eq!(solve(&skew, &ready, &Scene::<1>::new(), &quick), Err(IkError::BadInput));
+        assert_eq!(
+            solve(&crate::robot::PANDA, &skew, &ready, &Scene::<1>::new(), &quick),
+            Err(IkError::BadInput)
+        );
         let zero = IkConfig {
             starts: 0,
             ..IkConfig::default()
         };
-        assert_eq!(solve(&far, &ready, &Scene::<1>::new(), &zero), Err(IkError::BadConfig));
+        assert_eq!(
+            solve(&crate::robot::PANDA, &far, &ready, &Scene::<1>::new(), &zero),
+            Err(IkError::BadConfig)
+        );
     }
 }

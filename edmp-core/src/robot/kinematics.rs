@@ -381,10 +381,10 @@ mod tests {
     #[test]
     fn refuses_non_finite_gradients_and_reports_overflow() {
         let k = forward(&PANDA, &READY).unwrap();
-        let mut g = [[Vector3::zeros(); CORNERS]; BODIES];
+        let mut g = [[Vector3::zeros(); CORNERS]; MAX_BODIES];
         g[4][2].y = f32::NAN;
         assert_eq!(k.adjoint(&g), Err(Error::NonFiniteGradient));
-        let g = [[Vector3::repeat(f32::MAX); CORNERS]; BODIES];
+        let g = [[Vector3::repeat(f32::MAX); CORNERS]; MAX_BODIES];
         assert_eq!(k.adjoint(&g), Err(Error::Overflow));
     }
 

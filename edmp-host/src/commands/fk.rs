@@ -1,16 +1,22 @@
-//! `edmp-host fk`: print the pose of every link frame and collision box for one configuration.
+//! `edmp-host fk`: print the pose of every link frame and collision box for one configuration
+//! of any arm the host knows.
 
+use crate::arm::{Arm, with_arm};
 use edmp_core::Error;
 use edmp_core::robot::kinematics::{Joints, Pose, forward};
-use edmp_core::robot::{BODY_NAMES, FRAME_NAMES, JOINT_NAMES, JOINTS, PANDA, TCP_FRAME};
+use edmp_core::robot::{PANDA, Robot};
 use serde::Serialize;
 
 /// Arguments of `edmp-host fk`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The 7 joint angles in radians, joint 1 first.
-    #[arg(num_args = JOINTS, value_name = "JOINT", allow_negative_numbers = true, required = true)]
+    /// The joint angles in radians, joint 1 first: as many as the arm has (7 for the Panda and
+    /// the iiwa 7, 6 for the xArm 6).
+    #[arg(num_args = 1.., value_name = "JOINT", allow_negative_numbers = true, required = true)]
     joints: Vec<f64>,
+    /// The arm (the scene format's `robot` names).
+    #[arg(long, value_enum, default_value_t = Arm::Panda)]
+    robot: Arm,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
@@ -18,9 +24,11 @@ pub struct Args {
 
 #[derive(Debug, Serialize)]
 struct Report {
-    joints: [f32; JOINTS],
+    robot: &'static str,
+    joints: Vec<f32>,
     within_soft_limits: bool,
     tcp: PoseOut,
+    tcp_frame: &'static str,
     frames: Vec<Named>,
     collision_boxes: Vec<BoxOut>,
 }
@@ -55,19 +63,11 @@ impl From<&Pose<f32>> for PoseOut {
     }
 }
 
-/// Checks the joints (finite, f32-representable) and prints the kinematics.
+/// Checks the joints (as many as the arm has, finite, f32-representable) and prints the
+/// kinematics.
 pub fn run(args: &Args) -> Result<(), String> {
-    let mut q = [0.0f32; JOINTS];
-    for (i, (&value, slot)) in args.joints.iter().zip(q.iter_mut()).enumerate() {
-        if !value.is_finite() || value.abs() > f64::from(f32::MAX) {
-            return Err(format!(
-                "joints[{i}] ({}): {value} is not a finite number",
-                JOINT_NAMES[i]
-            ));
-        }
-        *slot = value as f32;
-    }
-    let report = report(&q).map_err(|e| format!("joints: {e}"))?;
+    let report = with_arm!(args.robot, robot => joints(robot, &args.joints)
+        .and_then(|q| report(robot, &q).map_err(|e| format!("joints: {e}"))))?;
     if args.json {
         let text = serde_json::to_string_pretty(&report).map_err(|e| format!("cannot write JSON: {e}"))?;
         println!("{text}");
@@ -80,26 +80,52 @@ pub fn run(args: &Args) -> Result<(), String> {
 /// The `--json` document for `q` (what `edmp-host fk --json` prints): the one writer of it,
 /// which the Python package's `fk` shares.
 pub fn document(q: &Joints<f32>) -> Result<serde_json::Value, Error> {
-    let report = report(q)?;
+    let report = report(&PANDA, q)?;
     Ok(serde_json::to_value(&report).unwrap_or(serde_json::Value::Null))
 }
 
-fn report(q: &Joints<f32>) -> Result<Report, Error> {
-    let q = *q;
-    let k = forward(&PANDA, &q)?;
+/// The command line's joints for `robot`: its number of them, each finite in f32.
+fn joints<const J: usize>(robot: &Robot<f32, J>, values: &[f64]) -> Result<[f32; J], String> {
+    if values.len() != J {
+        return Err(format!(
+            "joints: {} has {J} joints ({}), {} given",
+            robot.name,
+            robot.joint_names.join(", "),
+            values.len()
+        ));
+    }
+    let mut q = [0.0f32; J];
+    for (i, (&value, slot)) in values.iter().zip(q.iter_mut()).enumerate() {
+        if !value.is_finite() || value.abs() > f64::from(f32::MAX) {
+            return Err(format!(
+                "joints[{i}] ({}): {value} is not a finite number",
+                robot.joint_names[i]
+            ));
+        }
+        *slot = value as f32;
+    }
+    Ok(q)
+}
+
+fn report<const J: usize>(robot: &'static Robot<f32, J>, q: &[f32; J]) -> Result<Report, Error> {
+    let k = forward(robot, q)?;
     Ok(Report {
-        joints: q,
-        within_soft_limits: PANDA.within_soft_limits(&q, 0.0),
+        robot: robot.name,
+        joints: q.to_vec(),
+        within_soft_limits: robot.within_soft_limits(q, 0.0),
         tcp: k.tcp().into(),
-        frames: FRAME_NAMES
+        tcp_frame: robot.frame_names[robot.tcp_frame],
+        frames: robot
+            .frame_names
             .iter()
             .zip(k.frames.iter())
             .map(|(&name, p)| Named { name, pose: p.into() })
             .collect(),
-        collision_boxes: BODY_NAMES
+        collision_boxes: robot
+            .body_names
             .iter()
             .zip(k.boxes.iter())
-            .zip(PANDA.bodies.iter())
+            .zip(robot.bodies.iter())
             .map(|((&name, p), spec)| BoxOut {
                 name,
                 pose: p.into(),
@@ -111,7 +137,10 @@ fn report(q: &Joints<f32>) -> Result<Report, Error> {
 
 fn print_table(r: &Report) {
     let limits = if r.within_soft_limits { "within" } else { "OUTSIDE" };
-    println!("joints (rad): {:?}  ({limits} the soft limits)", r.joints);
+    println!(
+        "{} joints (rad): {:?}  ({limits} the planning limits)",
+        r.robot, r.joints
+    );
     println!(
         "{:<20} {:>9} {:>9} {:>9}   {:>8} {:>8} {:>8} {:>8}",
         "frame", "x", "y", "z", "qw", "qx", "qy", "qz"
@@ -134,5 +163,5 @@ fn print_table(r: &Report) {
         );
     }
     println!();
-    row(&format!("TCP ({})", FRAME_NAMES[TCP_FRAME]), &r.tcp);
+    row(&format!("TCP ({})", r.tcp_frame), &r.tcp);
 }

@@ -5,6 +5,7 @@
 pub use super::fields::InputError;
 use super::fields::{field, number, numbers, object, quaternion};
 use super::surface::{Surfaces, build_surfaces, inside_closed_mesh, is_surface, read_obstacle};
+use crate::arm::Arm;
 use edmp_core::collision::checker::{CheckConfig, Contact, check_end};
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
@@ -193,9 +194,15 @@ pub fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
                 rotation,
                 translation: position.into(),
             };
-            solve(&target, &problem.start, &problem.scene(), &IkConfig::default())
-                .map(|s| s.joints)
-                .map_err(|e| format!("goal.pose: unreachable: {e}"))
+            solve(
+                &edmp_core::robot::PANDA,
+                &target,
+                &problem.start,
+                &problem.scene(),
+                &IkConfig::default(),
+            )
+            .map(|s| s.joints)
+            .map_err(|e| format!("goal.pose: unreachable: {e}"))
         }
     }
 }
@@ -214,6 +221,31 @@ pub fn read_problem(path: &Path) -> Result<Problem, String> {
     parse_problem_in(&text, dir).map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// The scene's `robot` (absent: the Panda). The host knows the iiwa 7 and the xArm 6 (their
+/// kinematics, `edmp-host fk --robot`, and the exact checker), but plans for the Panda only:
+/// a scene for another arm is refused by name, never planned as if it were a Panda's.
+fn read_robot(value: Option<&Value>) -> Result<Arm, InputError> {
+    let Some(value) = value else { return Ok(Arm::Panda) };
+    let known = || Arm::ALL.map(Arm::name).join(", ");
+    let name = value
+        .as_str()
+        .ok_or_else(|| InputError::at("robot", format!("expected a string, one of: {}", known())))?;
+    match Arm::from_name(name) {
+        Some(Arm::Panda) => Ok(Arm::Panda),
+        Some(arm) => Err(InputError::at(
+            "robot",
+            format!(
+                "\"{arm}\": planning for this arm is not built yet (its kinematics are: `edmp-host fk --robot {arm}`); \
+                 the planner runs \"panda\""
+            ),
+        )),
+        None => Err(InputError::at(
+            "robot",
+            format!("unknown arm {value}, expected one of: {}", known()),
+        )),
+    }
+}
+
 /// Parses and validates an `edmp-scene/1` document; files it names lie relative to `dir`.
 pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
     let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
@@ -222,7 +254,16 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
     let map = object(
         &root,
         "",
-        &["format", "obstacles", "start", "goal", "held_object", "gripper", "meta"],
+        &[
+            "format",
+            "robot",
+            "obstacles",
+            "start",
+            "goal",
+            "held_object",
+            "gripper",
+            "meta",
+        ],
     )?;
     if let Some(meta) = map.get("meta") {
         meta.as_object()
@@ -235,6 +276,7 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
             format!("expected \"edmp-scene/1\", found {format}"),
         ));
     }
+    read_robot(map.get("robot"))?;
     let (obstacles, op) = field(map, "", "obstacles")?;
     let list = obstacles
         .as_array()
@@ -376,6 +418,23 @@ mod tests {
         assert_eq!(p.scene().obstacles().len(), 3);
         assert!(p.scene().held().is_some());
         assert!(matches!(p.goal, Goal::Joints(_)));
+    }
+
+    #[test]
+    fn the_robot_field_names_the_panda_or_is_refused_by_name() {
+        let with = |robot: &str| {
+            GOOD.replace(
+                r#""format": "edmp-scene/1","#,
+                &format!(r#""format": "edmp-scene/1", "robot": {robot},"#),
+            )
+        };
+        assert!(parse_problem(&with(r#""panda""#)).is_ok());
+        assert!(error_of(&with(r#""iiwa7""#)).starts_with("robot: \"iiwa7\": planning for this arm is not built yet"));
+        assert_eq!(
+            error_of(&with(r#""ur5""#)),
+            "robot: unknown arm \"ur5\", expected one of: panda, iiwa7, xarm6"
+        );
+        assert!(error_of(&with("7")).starts_with("robot: expected a string"));
     }
 
     #[test]

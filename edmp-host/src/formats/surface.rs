@@ -518,8 +518,8 @@ pub fn inside_closed_mesh(surfaces: &Surfaces, q: &Joints<f32>, finger: f32) -> 
         if !is_closed(vertices, triangles) {
             continue;
         }
-        for (b, pose) in k.boxes.iter().enumerate() {
-            if edmp_core::robot::PANDA.bodies[b].frame != 0 && encloses(vertices, triangles, &pose.translation) {
+        for (b, (pose, body)) in k.boxes.iter().zip(edmp_core::robot::PANDA.bodies).enumerate() {
+            if body.frame != 0 && encloses(vertices, triangles, &pose.translation) {
                 return Some((edmp_core::robot::BODY_NAMES[b], o.index));
             }
         }

@@ -136,7 +136,7 @@ pub(crate) fn reach(
     };
     for _ in 0..attempts {
         let pose = region.sample(rng);
-        if let Ok(s) = solve(&pose, &NEUTRAL, scene, &ik) {
+        if let Ok(s) = solve(&edmp_core::robot::PANDA, &pose, &NEUTRAL, scene, &ik) {
             let reached = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &s.joints)
                 .ok()?
                 .tcp();
