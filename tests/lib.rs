@@ -310,3 +310,22 @@ pub mod reference {
         }
     }
 }
+
+/// Position (metres) and rotation (radians) error of an f32 pose against a recorded PyBullet
+/// pose `[x, y, z, qw, qx, qy, qz]` (the FK fixtures' layout).
+pub fn pose_errors(got: &edmp_core::robot::kinematics::Pose<f32>, recorded: &[f64]) -> (f64, f64) {
+    let expected_pos = Vector3::new(recorded[0], recorded[1], recorded[2]);
+    let quat = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+        recorded[3],
+        recorded[4],
+        recorded[5],
+        recorded[6],
+    ));
+    let expected_rot = *quat.to_rotation_matrix().matrix();
+    let position = (got.translation.cast::<f64>() - expected_pos).norm();
+    // Angle of aᵀb from its skew part: well conditioned for the tiny angles measured here.
+    let d = got.rotation.cast::<f64>().transpose() * expected_rot;
+    let v = Vector3::new(d[(2, 1)] - d[(1, 2)], d[(0, 2)] - d[(2, 0)], d[(1, 0)] - d[(0, 1)]) * 0.5;
+    let cos = (d.trace() - 1.0) * 0.5;
+    (position, v.norm().atan2(cos))
+}

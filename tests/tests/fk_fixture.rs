@@ -3,19 +3,11 @@
 use edmp_core::robot::kinematics::forward;
 use edmp_core::robot::{FRAME_NAMES, FRAMES};
 use edmp_tests::fk_fixture;
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 
 /// Budgets: position 1e-5 m, rotation 1e-5 rad (the issue's), for the f32 planner FK.
 const POSITION_TOL: f64 = 1e-5;
 const ROTATION_TOL: f64 = 1e-5;
-
-fn rotation_angle(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
-    // Angle of aᵀb from its skew part: well conditioned for the tiny angles measured here.
-    let d = a.transpose() * b;
-    let v = Vector3::new(d[(2, 1)] - d[(1, 2)], d[(0, 2)] - d[(2, 0)], d[(1, 0)] - d[(0, 1)]) * 0.5;
-    let cos = (d.trace() - 1.0) * 0.5;
-    v.norm().atan2(cos)
-}
 
 #[test]
 fn fk_matches_pybullet_for_every_recorded_configuration() {
@@ -33,12 +25,7 @@ fn fk_matches_pybullet_for_every_recorded_configuration() {
         let k = forward(&edmp_core::robot::PANDA, &q).expect("finite joints");
         assert_eq!(sample.poses.len(), FRAMES);
         for (f, pose) in sample.poses.iter().enumerate() {
-            let expected_pos = Vector3::new(pose[0], pose[1], pose[2]);
-            let quat = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(pose[3], pose[4], pose[5], pose[6]));
-            let expected_rot = *quat.to_rotation_matrix().matrix();
-            let got = &k.frames[f];
-            let pos_err = (got.translation.cast::<f64>() - expected_pos).norm();
-            let rot_err = rotation_angle(&got.rotation.cast::<f64>(), &expected_rot);
+            let (pos_err, rot_err) = edmp_tests::pose_errors(&k.frames[f], pose);
             assert!(
                 pos_err <= POSITION_TOL,
                 "sample {n} {}: position off by {pos_err:e} m",

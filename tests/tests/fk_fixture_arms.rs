@@ -5,7 +5,7 @@
 use edmp_core::robot::Robot;
 use edmp_core::robot::arms::{iiwa7, xarm6};
 use edmp_core::robot::kinematics::forward;
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 use serde::Deserialize;
 use std::collections::BTreeSet;
 
@@ -55,14 +55,6 @@ fn xarm6_fixture() -> Fixture {
     )
 }
 
-fn rotation_angle(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
-    // Angle of aᵀb from its skew part: well conditioned for the tiny angles measured here.
-    let d = a.transpose() * b;
-    let v = Vector3::new(d[(2, 1)] - d[(1, 2)], d[(0, 2)] - d[(2, 0)], d[(1, 0)] - d[(0, 1)]) * 0.5;
-    let cos = (d.trace() - 1.0) * 0.5;
-    v.norm().atan2(cos)
-}
-
 fn joints<const J: usize>(sample: &Sample) -> [f64; J] {
     assert_eq!(sample.joints.len(), J);
     core::array::from_fn(|i| sample.joints[i])
@@ -81,12 +73,7 @@ fn check_fk<const J: usize>(robot: &'static Robot<f32, J>, fixture: &Fixture) ->
         let k = forward(robot, &q).expect("finite joints");
         assert_eq!(sample.poses.len(), robot.frames.len());
         for (f, pose) in sample.poses.iter().enumerate() {
-            let expected_pos = Vector3::new(pose[0], pose[1], pose[2]);
-            let quat = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(pose[3], pose[4], pose[5], pose[6]));
-            let expected_rot = *quat.to_rotation_matrix().matrix();
-            let got = &k.frames[f];
-            let pos_err = (got.translation.cast::<f64>() - expected_pos).norm();
-            let rot_err = rotation_angle(&got.rotation.cast::<f64>(), &expected_rot);
+            let (pos_err, rot_err) = edmp_tests::pose_errors(&k.frames[f], pose);
             let name = robot.frame_names[f];
             assert!(
                 pos_err <= POSITION_TOL,
