@@ -23,7 +23,7 @@ pub enum PairRule {
 }
 
 /// One arm: its URDF and the facts around it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ArmSpec {
     /// The scene format's `robot` name, the generated module's name and the cargo feature.
     pub name: &'static str,
@@ -39,6 +39,10 @@ pub struct ArmSpec {
     pub gripper: bool,
     /// How the self-collision pairs are chosen.
     pub pairs: PairRule,
+    /// The ready configuration problems start from or return to (the scene generators'
+    /// neutral ends), one value per actuated joint in URDF order: the gripper pointing down in
+    /// front of the base, elbow up.
+    pub neutral: &'static [f64],
 }
 
 /// Every arm, the Panda first.
@@ -51,6 +55,8 @@ pub const ARMS: [ArmSpec; 3] = [
         limits: LimitSource::SafetyController,
         gripper: true,
         pairs: PairRule::Levels,
+        // MpiNets' neutral configuration (robofin `FrankaRobot.NEUTRAL`).
+        neutral: &[-0.0178, -0.7601, 0.0198, -2.3421, 0.0298, 1.5412, 0.7534],
     },
     // KUKA LBR iiwa 7 (pybullet_data/kuka_iiwa): 7 revolute joints, one STL hull per link,
     // no tool flange link, so the TCP and the hand are the last link.
@@ -62,6 +68,8 @@ pub const ARMS: [ArmSpec; 3] = [
         limits: LimitSource::Limit,
         gripper: false,
         pairs: PairRule::ApartAtZero,
+        // Flange at about (0.43, 0, 0.46) m, pointing down (q2 - q4 + q6 ≈ π).
+        neutral: &[0.0, 0.2, 0.0, -2.0, 0.0, 0.95, 0.0],
     },
     // UFACTORY xArm 6 (pybullet_data/xarm): 6 revolute joints under a geometry-free `world`
     // root, V-HACD collision meshes (several convex pieces per link).
@@ -73,6 +81,8 @@ pub const ARMS: [ArmSpec; 3] = [
         limits: LimitSource::Limit,
         gripper: false,
         pairs: PairRule::ApartAtZero,
+        // Flange at about (0.34, 0, 0.43) m, pointing down.
+        neutral: &[0.0, -0.5, -0.8, 0.0, 1.3, 0.0],
     },
 ];
 

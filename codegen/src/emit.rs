@@ -256,6 +256,14 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         w,
         &format!("            hard_upper: [{}],", limits(&|i| chain.joints[i].hard[1])),
     );
+    wl(
+        w,
+        "            // The ready configuration the scene generators' neutral ends start from (codegen's ARMS).",
+    );
+    wl(
+        w,
+        &format!("            neutral: [{}],", limits(&|i| chain.arm.neutral[i])),
+    );
     match &chain.gripper {
         Some(gripper) => {
             let [lower, upper] = gripper.limits;

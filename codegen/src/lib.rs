@@ -42,6 +42,22 @@ pub struct GeneratedArm {
 /// repository-relative path.
 pub fn generate_robot(urdf: &Path, arm: &arms::ArmSpec) -> Result<GeneratedArm, String> {
     let chain = urdf::read_chain(urdf, arm)?;
+    if arm.neutral.len() != chain.joints.len() {
+        return Err(format!(
+            "arm `{}`: neutral has {} values, the URDF {} actuated joints",
+            arm.name,
+            arm.neutral.len(),
+            chain.joints.len()
+        ));
+    }
+    if let Some(i) = (0..chain.joints.len())
+        .find(|&i| !(chain.joints[i].soft[0]..=chain.joints[i].soft[1]).contains(&arm.neutral[i]))
+    {
+        return Err(format!(
+            "arm `{}`: neutral[{i}] = {} is outside the planning range {:?}",
+            arm.name, arm.neutral[i], chain.joints[i].soft
+        ));
+    }
     Ok(GeneratedArm {
         frames: chain.frames.len(),
         bodies: chain.bodies.len(),

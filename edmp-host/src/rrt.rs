@@ -11,8 +11,7 @@ use core::time::Duration;
 use edmp_core::collision::checker::{CheckConfig, check_end, check_segment, check_trajectory};
 use edmp_core::path::HORIZON;
 use edmp_core::rng::Rng;
-use edmp_core::robot::PANDA;
-use edmp_core::robot::kinematics::Joints;
+use edmp_core::robot::Robot;
 use edmp_core::scene::Scene;
 use std::time::Instant;
 
@@ -57,29 +56,29 @@ pub(crate) enum RrtError {
 
 /// A planned trajectory.
 #[derive(Clone, Debug)]
-pub(crate) struct RrtPlan<const H: usize> {
+pub(crate) struct RrtPlan<const H: usize, const J: usize> {
     /// `H` waypoints from start to goal, collision-free with interpolation.
-    pub waypoints: [Joints<f32>; H],
+    pub waypoints: [[f32; J]; H],
     /// Tree nodes grown.
     pub nodes: usize,
     /// Wall-clock planning time.
     pub elapsed: Duration,
 }
 
-struct Tree {
-    nodes: Vec<Joints<f32>>,
+struct Tree<const J: usize> {
+    nodes: Vec<[f32; J]>,
     parent: Vec<usize>,
 }
 
-impl Tree {
-    fn new(root: Joints<f32>) -> Self {
+impl<const J: usize> Tree<J> {
+    fn new(root: [f32; J]) -> Self {
         Self {
             nodes: vec![root],
             parent: vec![0],
         }
     }
 
-    fn nearest(&self, q: &Joints<f32>) -> usize {
+    fn nearest(&self, q: &[f32; J]) -> usize {
         let mut best = (f32::INFINITY, 0);
         for (i, n) in self.nodes.iter().enumerate() {
             let d = distance2(n, q);
@@ -90,7 +89,7 @@ impl Tree {
         best.1
     }
 
-    fn path_to_root(&self, mut i: usize) -> Vec<Joints<f32>> {
+    fn path_to_root(&self, mut i: usize) -> Vec<[f32; J]> {
         let mut path = vec![self.nodes[i]];
         while i != 0 {
             i = self.parent[i];
@@ -100,16 +99,16 @@ impl Tree {
     }
 }
 
-fn distance2(a: &Joints<f32>, b: &Joints<f32>) -> f32 {
+fn distance2<const J: usize>(a: &[f32; J], b: &[f32; J]) -> f32 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
-fn distance(a: &Joints<f32>, b: &Joints<f32>) -> f32 {
+fn distance<const J: usize>(a: &[f32; J], b: &[f32; J]) -> f32 {
     distance2(a, b).sqrt()
 }
 
 /// `from` moved towards `to` by at most `step` on every joint.
-fn steer(from: &Joints<f32>, to: &Joints<f32>, step: f32) -> Joints<f32> {
+fn steer<const J: usize>(from: &[f32; J], to: &[f32; J], step: f32) -> [f32; J] {
     let widest = from.iter().zip(to).map(|(a, b)| (b - a).abs()).fold(0.0, f32::max);
     if widest <= step {
         return *to;
@@ -118,30 +117,31 @@ fn steer(from: &Joints<f32>, to: &Joints<f32>, step: f32) -> Joints<f32> {
     core::array::from_fn(|j| from[j] + (to[j] - from[j]) * t)
 }
 
-struct Planner<'a, const N: usize> {
+struct Planner<'a, const J: usize, const N: usize> {
+    robot: &'static Robot<f32, J>,
     scene: &'a Scene<'a, N>,
     check: CheckConfig,
     /// The problem's start and goal: states near them keep the checker's end margin.
-    ends: [Joints<f32>; 2],
+    ends: [[f32; J]; 2],
 }
 
-impl<const N: usize> Planner<'_, N> {
+impl<const J: usize, const N: usize> Planner<'_, J, N> {
     /// A valid end (docs/formats.md): inside the limits and free by PyBullet's own rule.
-    fn valid_end(&self, q: &Joints<f32>) -> Result<bool, RrtError> {
-        let ok = PANDA.within_soft_limits(q, 0.0);
+    fn valid_end(&self, q: &[f32; J]) -> Result<bool, RrtError> {
+        let ok = self.robot.within_soft_limits(q, 0.0);
         Ok(ok
-            && check_end(&edmp_core::robot::PANDA, self.scene, q, &self.check)
+            && check_end(self.robot, self.scene, q, &self.check)
                 .map_err(RrtError::Checker)?
                 .is_none())
     }
 
-    fn edge_free(&self, a: &Joints<f32>, b: &Joints<f32>) -> Result<bool, RrtError> {
+    fn edge_free(&self, a: &[f32; J], b: &[f32; J]) -> Result<bool, RrtError> {
         let [start, goal] = &self.ends;
-        check_segment(&edmp_core::robot::PANDA, self.scene, a, b, [start, goal], &self.check).map_err(RrtError::Checker)
+        check_segment(self.robot, self.scene, a, b, [start, goal], &self.check).map_err(RrtError::Checker)
     }
 
     /// One step of `tree` towards `target`; the new node's index if the edge is free.
-    fn extend(&self, tree: &mut Tree, target: &Joints<f32>, step: f32) -> Result<Option<usize>, RrtError> {
+    fn extend(&self, tree: &mut Tree<J>, target: &[f32; J], step: f32) -> Result<Option<usize>, RrtError> {
         let near = tree.nearest(target);
         let q = steer(&tree.nodes[near], target, step);
         if !self.edge_free(&tree.nodes[near], &q)? {
@@ -153,7 +153,7 @@ impl<const N: usize> Planner<'_, N> {
     }
 
     /// Extends `tree` towards `target` until it arrives (its index) or is blocked.
-    fn connect(&self, tree: &mut Tree, target: &Joints<f32>, step: f32) -> Result<Option<usize>, RrtError> {
+    fn connect(&self, tree: &mut Tree<J>, target: &[f32; J], step: f32) -> Result<Option<usize>, RrtError> {
         loop {
             match self.extend(tree, target, step)? {
                 None => return Ok(None),
@@ -163,7 +163,7 @@ impl<const N: usize> Planner<'_, N> {
         }
     }
 
-    fn shortcut(&self, path: &mut Vec<Joints<f32>>, attempts: u32, rng: &mut Rng) -> Result<(), RrtError> {
+    fn shortcut(&self, path: &mut Vec<[f32; J]>, attempts: u32, rng: &mut Rng) -> Result<(), RrtError> {
         for _ in 0..attempts {
             if path.len() < 3 {
                 break;
@@ -179,7 +179,7 @@ impl<const N: usize> Planner<'_, N> {
 }
 
 /// Points evenly spaced by joint-space arc length along the polyline `path`.
-fn resample<const H: usize>(path: &[Joints<f32>]) -> [Joints<f32>; H] {
+fn resample<const H: usize, const J: usize>(path: &[[f32; J]]) -> [[f32; J]; H] {
     let lengths: Vec<f32> = path.windows(2).map(|w| distance(&w[0], &w[1])).collect();
     let total: f32 = lengths.iter().sum();
     let mut out = [path[0]; H];
@@ -203,16 +203,18 @@ fn resample<const H: usize>(path: &[Joints<f32>]) -> [Joints<f32>; H] {
     out
 }
 
-/// Plans from `start` to `goal` in `scene`.
-pub(crate) fn plan<const H: usize, const N: usize>(
+/// Plans from `start` to `goal` in `scene` for the arm `robot`.
+pub(crate) fn plan<const H: usize, const J: usize, const N: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    start: &Joints<f32>,
-    goal: &Joints<f32>,
+    start: &[f32; J],
+    goal: &[f32; J],
     config: &RrtConfig,
     seed: u64,
-) -> Result<RrtPlan<H>, RrtError> {
+) -> Result<RrtPlan<H, J>, RrtError> {
     let began = Instant::now();
     let planner = Planner {
+        robot,
         scene,
         check: CheckConfig::default(),
         ends: [*start, *goal],
@@ -235,7 +237,7 @@ pub(crate) fn plan<const H: usize, const N: usize>(
         if began.elapsed() > config.budget {
             return Err(RrtError::Timeout);
         }
-        let sample: Joints<f32> = core::array::from_fn(|j| rng.uniform_f32(PANDA.soft_lower[j], PANDA.soft_upper[j]));
+        let sample: [f32; J] = core::array::from_fn(|j| rng.uniform_f32(robot.soft_lower[j], robot.soft_upper[j]));
         if let Some(new) = planner.extend(&mut a, &sample, config.step)? {
             let target = a.nodes[new];
             if let Some(meet) = planner.connect(&mut b, &target, config.step)? {
@@ -253,13 +255,11 @@ pub(crate) fn plan<const H: usize, const N: usize>(
     }
     let mut path = raw.unwrap_or_default();
     planner.shortcut(&mut path, config.shortcuts, &mut rng)?;
-    let mut waypoints = resample::<H>(&path);
-    let free = |w: &[Joints<f32>; H]| -> Result<bool, RrtError> {
-        Ok(
-            check_trajectory(&edmp_core::robot::PANDA, scene, w, &planner.check, true)
-                .map_err(RrtError::Checker)?
-                .is_free(),
-        )
+    let mut waypoints = resample::<H, J>(&path);
+    let free = |w: &[[f32; J]; H]| -> Result<bool, RrtError> {
+        Ok(check_trajectory(robot, scene, w, &planner.check, true)
+            .map_err(RrtError::Checker)?
+            .is_free())
     };
     if !free(&waypoints)? {
         // Even spacing cut a corner: keep every vertex of the shortcut path instead (the
@@ -292,13 +292,14 @@ pub(crate) fn plan<const H: usize, const N: usize>(
 }
 
 /// Joint-space length of a trajectory (sum of Euclidean steps, radians).
-pub(crate) fn path_length(waypoints: &[Joints<f32>]) -> f32 {
+pub(crate) fn path_length<const J: usize>(waypoints: &[[f32; J]]) -> f32 {
     waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use edmp_core::robot::PANDA;
     use edmp_core::scene::Obstacle;
 
     fn wall_scene() -> Scene<'static, 8> {
@@ -330,7 +331,7 @@ mod tests {
             .unwrap()
             .is_free()
         );
-        let plan = plan::<50, 8>(&scene, &LEFT, &RIGHT, &RrtConfig::default(), 3).expect("a path exists");
+        let plan = plan::<50, 7, 8>(&PANDA, &scene, &LEFT, &RIGHT, &RrtConfig::default(), 3).expect("a path exists");
         assert_eq!(plan.waypoints[0], LEFT);
         assert_eq!(plan.waypoints[49], RIGHT);
         assert!(
@@ -355,8 +356,8 @@ mod tests {
             budget: Duration::from_secs(10),
             ..RrtConfig::default()
         };
-        let a = plan::<50, 8>(&scene, &LEFT, &RIGHT, &cfg, 11).unwrap();
-        let b = plan::<50, 8>(&scene, &LEFT, &RIGHT, &cfg, 11).unwrap();
+        let a = plan::<50, 7, 8>(&PANDA, &scene, &LEFT, &RIGHT, &cfg, 11).unwrap();
+        let b = plan::<50, 7, 8>(&PANDA, &scene, &LEFT, &RIGHT, &cfg, 11).unwrap();
         assert_eq!(a.waypoints, b.waypoints);
     }
 
@@ -375,11 +376,11 @@ mod tests {
             .is_some()
         );
         assert_eq!(
-            plan::<50, 8>(&scene, &inside, &RIGHT, &RrtConfig::default(), 1).err(),
+            plan::<50, 7, 8>(&PANDA, &scene, &inside, &RIGHT, &RrtConfig::default(), 1).err(),
             Some(RrtError::InvalidStart)
         );
         assert_eq!(
-            plan::<50, 8>(&scene, &LEFT, &inside, &RrtConfig::default(), 1).err(),
+            plan::<50, 7, 8>(&PANDA, &scene, &LEFT, &inside, &RrtConfig::default(), 1).err(),
             Some(RrtError::InvalidGoal)
         );
     }

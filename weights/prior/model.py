@@ -17,7 +17,7 @@ import torch.nn as nn
 import torch.nn.functional as F
 
 HORIZON = 50
-JOINTS = 7
+JOINTS = 7  # the Panda's; other arms pass `joints`
 GROUPS = 8
 KERNEL = 5
 T = 255
@@ -69,17 +69,18 @@ class ResBlock(nn.Module):
 
 
 class TemporalUNet(nn.Module):
-    """epsilon-prediction network: (B, 7, 50) noisy trajectory and step t -> (B, 7, 50) noise."""
+    """epsilon-prediction network: (B, J, 50) noisy trajectory and step t -> (B, J, 50) noise."""
 
-    def __init__(self, dims=(16, 32, 64), time_dim=32, time_hidden=128, top_skip=True):
+    def __init__(self, dims=(16, 32, 64), time_dim=32, time_hidden=128, top_skip=True, joints=JOINTS):
         super().__init__()
+        self.joints = joints
         self.dims = tuple(dims)
         self.top_skip = top_skip
         self.time_dim = time_dim
         self.time_hidden = time_hidden
         self.time_in = nn.Linear(time_dim, time_hidden)
         self.time_out = nn.Linear(time_hidden, time_dim)
-        widths = (JOINTS,) + self.dims
+        widths = (joints,) + self.dims
         levels = len(self.dims)
         self.down = nn.ModuleList()
         for i in range(levels):
@@ -102,7 +103,7 @@ class TemporalUNet(nn.Module):
             level.sample = nn.ConvTranspose1d(din, din, 4, stride=2, padding=1)
             self.up.append(level)
         self.final = ConvBlock((2 if top_skip else 1) * self.dims[0], self.dims[0])
-        self.out = nn.Conv1d(self.dims[0], JOINTS, 1)
+        self.out = nn.Conv1d(self.dims[0], joints, 1)
 
     def lengths(self):
         """Sequence length at each level: 50, 25, 13, ..."""
@@ -143,7 +144,7 @@ class TemporalUNet(nn.Module):
             "kernel": KERNEL,
             "groups": GROUPS,
             "horizon": HORIZON,
-            "joints": JOINTS,
+            "joints": self.joints,
             "lengths": self.lengths(),
             "top_skip": self.top_skip,
         }
@@ -171,7 +172,7 @@ class TemporalUNet(nn.Module):
             elif isinstance(m, nn.Linear):
                 hooks.append(m.register_forward_hook(linear_hook))
         with torch.no_grad():
-            self(torch.zeros(1, JOINTS, HORIZON), torch.ones(1))
+            self(torch.zeros(1, self.joints, HORIZON), torch.ones(1))
         for h in hooks:
             h.remove()
         return total

@@ -26,7 +26,7 @@ def load(directory):
 
     with open(os.path.join(directory, "prior.json")) as f:
         config = json.load(f)
-    model = TemporalUNet(tuple(config["dims"]), config["time_dim"], config["time_hidden"], config.get("top_skip", False))
+    model = TemporalUNet(tuple(config["dims"]), config["time_dim"], config["time_hidden"], config.get("top_skip", False), config.get("joints", 7))
     model.load_state_dict(load_file(os.path.join(directory, "prior.safetensors")))
     model.eval()
     return model

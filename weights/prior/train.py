@@ -22,12 +22,12 @@ import numpy as np
 import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from model import HORIZON, JOINTS, T, BETA_MAX, TemporalUNet, schedule  # noqa: E402
+from model import HORIZON, T, BETA_MAX, TemporalUNet, schedule  # noqa: E402
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", required=True, help="(N, 50, 7) float32 .npy from edmp-host gen-data")
+    ap.add_argument("--data", required=True, help="(N, 50, J) float32 .npy from edmp-host gen-data (J: the arm's joints)")
     ap.add_argument("--out", default=os.path.dirname(os.path.abspath(__file__)))
     ap.add_argument("--dims", default="16,32,64")
     ap.add_argument("--no-top-skip", action="store_true", help="leave the full-resolution skip unused, as the original")
@@ -47,14 +47,15 @@ def main():
     device = "cuda" if torch.cuda.is_available() else "cpu"
 
     data = np.load(args.data)
-    if data.ndim != 3 or data.shape[1:] != (HORIZON, JOINTS):
-        sys.exit(f"{args.data}: expected (N, {HORIZON}, {JOINTS}), got {data.shape}")
+    if data.ndim != 3 or data.shape[1] != HORIZON or data.shape[2] < 1:
+        sys.exit(f"{args.data}: expected (N, {HORIZON}, J), got {data.shape}")
+    joints = data.shape[2]
     x_all = torch.from_numpy(np.ascontiguousarray(data.transpose(0, 2, 1))).float().to(device)
     train, held = x_all[: -args.holdout], x_all[-args.holdout :]
 
     dims = tuple(int(d) for d in args.dims.split(","))
-    model = TemporalUNet(dims, top_skip=not args.no_top_skip).to(device)
-    ema = TemporalUNet(dims, top_skip=not args.no_top_skip).to(device)
+    model = TemporalUNet(dims, top_skip=not args.no_top_skip, joints=joints).to(device)
+    ema = TemporalUNet(dims, top_skip=not args.no_top_skip, joints=joints).to(device)
     ema.load_state_dict(model.state_dict())
     for p in ema.parameters():
         p.requires_grad_(False)

@@ -180,9 +180,10 @@ fn held_pair<const J: usize>(robot: &Robot<f32, J>, b: usize) -> bool {
 }
 
 /// Whether shape `body` (a robot body, or the held object after them) moves with the joints:
-/// bodies on the root frame are bolted to the mount.
+/// bodies with no actuated joint between them and the root (the Panda's link0, the xArm's
+/// `link_base` under its `world` link) are bolted to the mount.
 pub(crate) fn moves<const J: usize>(robot: &Robot<f32, J>, body: usize) -> bool {
-    robot.bodies.get(body).is_none_or(|b| b.frame != 0)
+    robot.bodies.get(body).is_none_or(|b| level(robot, b.frame) > 0)
 }
 
 const PLACEHOLDER: Solid = Solid {
@@ -475,7 +476,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
         if !untested {
             return Ok(None);
         }
-        let k = forward_with(robot, q, self.scene.gripper())?;
+        let k = forward_with(robot, q, robot.finger_opening(self.scene.gripper()))?;
         let self_margin = self.config.self_margin;
         let carry = self.config.margin.max(self.config.end_margin) + CARRY_SLACK;
         let carry_self = self_margin + CARRY_SLACK;
@@ -610,7 +611,7 @@ pub fn clearance<const J: usize, const N: usize>(
     scene: &Scene<N>,
     q: &[f32; J],
 ) -> Result<f32, Error> {
-    let k = forward_with(robot, q, scene.gripper())?;
+    let k = forward_with(robot, q, robot.finger_opening(scene.gripper()))?;
     let held = scene
         .held()
         .map(|h| Solid::attached(h, &k.frames[robot.hand_frame % MAX_FRAMES]));
@@ -908,6 +909,39 @@ mod tests {
             check_state(&crate::robot::PANDA, &scene, &READY, &CheckConfig::default()),
             Ok(None)
         );
+    }
+
+    #[test]
+    #[cfg(all(feature = "iiwa7", feature = "xarm6"))]
+    #[cfg_attr(miri, ignore = "the exact checker at many states: hours under Miri")]
+    fn other_arms_bolted_bases_and_missing_grippers() {
+        use crate::robot::arms::{iiwa7, xarm6};
+        // The mount's top at z = 0: under the iiwa's link 0, and under the xArm's `link_base`
+        // (fixed below a geometry-free `world` link, so frame 1, yet bolted down too).
+        let mut scene = Scene::<4>::new();
+        scene
+            .push(Obstacle::cuboid([0.0, 0.0, -0.01], [0.4, 0.4, 0.02], ID).unwrap())
+            .unwrap();
+        // The scene's default `gripper` (the Panda's 0.025 m) means nothing to an arm without
+        // a hand: not an error.
+        assert!(scene.gripper() > 0.0);
+        assert_eq!(
+            check_state(&iiwa7::ROBOT, &scene, &iiwa7::ROBOT.neutral, &CheckConfig::default()),
+            Ok(None)
+        );
+        assert_eq!(
+            check_state(&xarm6::ROBOT, &scene, &xarm6::ROBOT.neutral, &CheckConfig::default()),
+            Ok(None)
+        );
+        // Moving bodies still collide: the slab raised into the xArm's link 1.
+        let mut raised = Scene::<4>::new();
+        raised
+            .push(Obstacle::cuboid([0.0, 0.0, 0.2], [0.4, 0.4, 0.02], ID).unwrap())
+            .unwrap();
+        assert!(matches!(
+            check_state(&xarm6::ROBOT, &raised, &xarm6::ROBOT.neutral, &CheckConfig::default()),
+            Ok(Some(Contact::Obstacle { .. }))
+        ));
     }
 
     #[test]

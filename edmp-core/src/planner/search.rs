@@ -659,7 +659,7 @@ pub fn resample_even(path: &[Joints<f32>]) -> Path {
     out
 }
 
-fn set_ends(path: &mut Path, first: &Joints<f32>, last: &Joints<f32>) {
+fn set_ends<const J: usize>(path: &mut [[f32; J]; HORIZON], first: &[f32; J], last: &[f32; J]) {
     if let Some(q) = path.first_mut() {
         *q = *first;
     }
@@ -673,7 +673,7 @@ fn set_ends(path: &mut Path, first: &Joints<f32>, last: &Joints<f32>) {
 /// longest. Every output segment then lies on a polyline segment, so no corner is cut.
 /// `None` when the polyline has more segments than the output. Public for the host's
 /// RRT-Connect baseline, whose even resampling can cut a corner too.
-pub fn resample_through_vertices(path: &[Joints<f32>]) -> Option<Path> {
+pub fn resample_through_vertices<const J: usize>(path: &[[f32; J]]) -> Option<[[f32; J]; HORIZON]> {
     let segments = path.len().checked_sub(1)?;
     if segments == 0 || segments > SPANS {
         return None;
@@ -761,19 +761,19 @@ fn below(rng: &mut Rng, n: usize) -> usize {
     rng.below(u32::try_from(n).unwrap_or(u32::MAX)) as usize
 }
 
-fn distance2(a: &Joints<f32>, b: &Joints<f32>) -> f32 {
+fn distance2<const J: usize>(a: &[f32; J], b: &[f32; J]) -> f32 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
 /// Euclidean length of a two-point window (0 for any other length).
-pub(crate) fn segment_length(w: &[Joints<f32>]) -> f32 {
+pub(crate) fn segment_length<const J: usize>(w: &[[f32; J]]) -> f32 {
     match w {
         [a, b] => crate::float::sqrt(distance2(a, b)),
         _ => 0.0,
     }
 }
 
-fn lerp(a: &Joints<f32>, b: &Joints<f32>, t: f32) -> Joints<f32> {
+fn lerp<const J: usize>(a: &[f32; J], b: &[f32; J], t: f32) -> [f32; J] {
     let mut q = *a;
     for (v, (x, y)) in q.iter_mut().zip(a.iter().zip(b)) {
         *v = x + (y - x) * t;

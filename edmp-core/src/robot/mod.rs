@@ -101,6 +101,9 @@ pub struct Robot<T: 'static, const J: usize> {
     pub hard_lower: [T; J],
     /// URDF `<limit upper>`.
     pub hard_upper: [T; J],
+    /// The ready configuration: the gripper pointing down in front of the base (the Panda:
+    /// MpiNets' neutral). Scene generators start or end problems near it.
+    pub neutral: [T; J],
     /// The gripper, for arms with one.
     pub gripper: Option<Gripper<T>>,
     /// Per body and joint, how far a point of the body can be from the joint's axis, in `f32`
@@ -148,6 +151,17 @@ impl Real for f64 {
 }
 
 impl<T: Real, const J: usize> Robot<T, J> {
+    /// The finger opening a scene's `gripper` means for this arm: the scene's where the arm
+    /// has a gripper, 0 where it has none (docs/formats.md: `gripper` applies where the arm
+    /// has a hand).
+    pub fn finger_opening(&self, scene_gripper: T) -> T {
+        if self.gripper.is_some() {
+            scene_gripper
+        } else {
+            T::zero()
+        }
+    }
+
     /// Whether every joint lies within the soft (planning) limits, `tolerance` outside allowed.
     pub fn within_soft_limits(&self, q: &[T; J], tolerance: T) -> bool {
         (0..J).all(|i| q[i] >= self.soft_lower[i] - tolerance && q[i] <= self.soft_upper[i] + tolerance)

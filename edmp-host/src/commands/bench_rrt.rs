@@ -41,7 +41,14 @@ fn run_one(path: &Path, budget: Duration, seed: u64) -> Result<Outcome, String> 
         ..RrtConfig::default()
     };
     let began = std::time::Instant::now();
-    let planned = plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene(), &p.start, &goal, &config, seed);
+    let planned = plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+        &edmp_core::robot::PANDA,
+        &p.scene(),
+        &p.start,
+        &goal,
+        &config,
+        seed,
+    );
     Ok(Outcome {
         ms: began.elapsed().as_secs_f64() * 1e3,
         length: planned.ok().map(|r| path_length(&r.waypoints)),

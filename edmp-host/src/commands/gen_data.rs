@@ -9,12 +9,13 @@
 //! collision-free by the exact checker with 0.01 rad interpolation (the planner checks it).
 //! Output: one `.npy` file, float32, shape (count, 50, 7), which `numpy.load` reads as is.
 
+use crate::arm::{Arm, with_arm};
 use crate::rrt::{RrtConfig, path_length, plan};
 use crate::scenes::{Family, environment, neutral, reach};
 use core::time::Duration;
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::rng::Rng;
-use edmp_core::robot::kinematics::Joints;
+use edmp_core::robot::Robot;
 use edmp_core::scene::MAX_OBSTACLES;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -34,6 +35,9 @@ pub struct Args {
     /// Output `.npy` file.
     #[arg(long)]
     out: PathBuf,
+    /// The arm (docs/formats.md, "Other arms"): trajectories have its number of joints.
+    #[arg(long, value_enum, default_value_t = Arm::Panda)]
+    robot: Arm,
 }
 
 const HORIZON: usize = 50;
@@ -51,24 +55,24 @@ fn family_of(seed: u64) -> Family {
 
 /// What one environment gave.
 #[derive(Default)]
-struct Harvest {
-    trajectories: Vec<[Joints<f32>; HORIZON]>,
+struct Harvest<const J: usize> {
+    trajectories: Vec<[[f32; J]; HORIZON]>,
     failures: usize,
 }
 
-fn harvest(seed: u64) -> Harvest {
+fn harvest<const J: usize>(robot: &'static Robot<f32, J>, seed: u64) -> Harvest<J> {
     let mut rng = Rng::new(seed ^ 0x5EED_DA7A);
     let env = environment(family_of(seed), &mut rng);
     let Some(scene) = env.scene() else {
         return Harvest::default();
     };
-    let mut candidates: Vec<Joints<f32>> = Vec::new();
+    let mut candidates: Vec<[f32; J]> = Vec::new();
     for k in 0..CANDIDATES {
         let got = if k < 2 || env.regions.is_empty() {
-            neutral(&scene, &mut rng)
+            neutral(robot, &scene, &mut rng)
         } else {
             let region = &env.regions[rng.below(env.regions.len() as u32) as usize];
-            reach(&scene, region, &mut rng, 4).map(|(q, _)| q)
+            reach(robot, &scene, region, &mut rng, 4).map(|(q, _)| q)
         };
         candidates.extend(got);
     }
@@ -79,7 +83,14 @@ fn harvest(seed: u64) -> Harvest {
     };
     for i in 0..candidates.len() {
         for j in i + 1..candidates.len() {
-            match plan::<HORIZON, MAX_OBSTACLES>(&scene, &candidates[i], &candidates[j], &config, rng.next_u64()) {
+            match plan::<HORIZON, J, MAX_OBSTACLES>(
+                robot,
+                &scene,
+                &candidates[i],
+                &candidates[j],
+                &config,
+                rng.next_u64(),
+            ) {
                 Ok(p) => {
                     out.trajectories.push(p.waypoints);
                     // The checker may call a near-margin state colliding depending on the
@@ -87,7 +98,7 @@ fn harvest(seed: u64) -> Harvest {
                     // reversed path is kept only if it passes on its own.
                     let mut back = p.waypoints;
                     back.reverse();
-                    match check_trajectory(&edmp_core::robot::PANDA, &scene, &back, &CheckConfig::default(), true) {
+                    match check_trajectory(robot, &scene, &back, &CheckConfig::default(), true) {
                         Ok(r) if r.is_free() => out.trajectories.push(back),
                         _ => out.failures += 1,
                     }
@@ -99,10 +110,10 @@ fn harvest(seed: u64) -> Harvest {
     out
 }
 
-/// Writes `data` as a C-order float32 `.npy` array of shape `(n, HORIZON, 7)`.
-pub fn write_npy(path: &Path, data: &[[Joints<f32>; HORIZON]]) -> std::io::Result<()> {
+/// Writes `data` as a C-order float32 `.npy` array of shape `(n, HORIZON, J)`.
+pub fn write_npy<const J: usize>(path: &Path, data: &[[[f32; J]; HORIZON]]) -> std::io::Result<()> {
     let dict = format!(
-        "{{'descr': '<f4', 'fortran_order': False, 'shape': ({}, {HORIZON}, 7), }}",
+        "{{'descr': '<f4', 'fortran_order': False, 'shape': ({}, {HORIZON}, {J}), }}",
         data.len()
     );
     // Magic (6) + version (2) + header length (2) + header, padded with spaces to a multiple of 64.
@@ -120,6 +131,10 @@ pub fn write_npy(path: &Path, data: &[[Joints<f32>; HORIZON]]) -> std::io::Resul
 
 /// Generates and writes the trajectories, with a progress bar and a summary.
 pub fn run(args: &Args) -> Result<(), String> {
+    with_arm!(args.robot, robot => generate(robot, args))
+}
+
+fn generate<const J: usize>(robot: &'static Robot<f32, J>, args: &Args) -> Result<(), String> {
     let began = Instant::now();
     let bar = ProgressBar::new(args.problems as u64);
     bar.set_style(
@@ -132,7 +147,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     while data.len() < args.problems {
         let seeds: Vec<u64> = (environments..environments + batch).map(|e| args.seed + e).collect();
         environments += batch;
-        let harvests: Vec<Harvest> = seeds.par_iter().map(|&s| harvest(s)).collect();
+        let harvests: Vec<Harvest<J>> = seeds.par_iter().map(|&s| harvest(robot, s)).collect();
         for h in harvests {
             failures += h.failures;
             let room = args.problems - data.len();
@@ -144,8 +159,9 @@ pub fn run(args: &Args) -> Result<(), String> {
     write_npy(&args.out, &data).map_err(|e| format!("{}: {e}", args.out.display()))?;
     let mean = data.iter().map(|t| f64::from(path_length(t))).sum::<f64>() / data.len().max(1) as f64;
     eprintln!(
-        "gen-data: {} trajectories from {environments} environments in {:.1} s ({:.1}/s); {failures} failures \
+        "gen-data ({}): {} trajectories from {environments} environments in {:.1} s ({:.1}/s); {failures} failures \
          (pairs without a path in 1 s, reversed paths the checker refused); mean joint-space path length {mean:.2} rad; wrote {}",
+        robot.name,
         data.len(),
         began.elapsed().as_secs_f64(),
         data.len() as f64 / began.elapsed().as_secs_f64(),
@@ -157,7 +173,6 @@ pub fn run(args: &Args) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use edmp_core::robot::PANDA;
 
     /// The unseen suite measures generalization only if training never draws its kinds.
     #[test]
@@ -187,20 +202,48 @@ mod tests {
     }
 
     #[test]
-    fn harvested_trajectories_are_free_and_within_limits() {
+    fn a_six_joint_arm_writes_six_columns() {
+        let path = std::env::temp_dir().join(format!("edmp-npy6-{}.npy", std::process::id()));
+        write_npy(&path, &[[[0.25f32; 6]; HORIZON]; 2]).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::remove_file(&path).ok();
+        let len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
+        let header = core::str::from_utf8(&bytes[10..10 + len]).unwrap();
+        assert!(header.contains("'shape': (2, 50, 6)"), "{header}");
+        assert_eq!(bytes.len(), 10 + len + 2 * 50 * 6 * 4);
+    }
+
+    /// Every trajectory `harvest` gives for `robot` is free by the exact checker, within the
+    /// arm's limits and joins two of its candidates; some are found.
+    fn harvest_is_free<const J: usize>(robot: &'static Robot<f32, J>, seeds: core::ops::Range<u64>) {
         let mut total = 0;
-        for seed in 0..3u64 {
+        for seed in seeds {
             let mut rng = Rng::new(seed ^ 0x5EED_DA7A);
             let env = environment(family_of(seed), &mut rng);
             let scene = env.scene().unwrap();
-            let h = harvest(seed);
+            let h = harvest(robot, seed);
             for (i, t) in h.trajectories.iter().enumerate() {
-                assert!(t.iter().all(|q| PANDA.within_soft_limits(q, 1e-5)));
-                let r = check_trajectory(&edmp_core::robot::PANDA, &scene, t, &CheckConfig::default(), true).unwrap();
-                assert!(r.is_free(), "seed {seed} trajectory {i}: {r:?}");
+                assert!(
+                    t.iter().all(|q| robot.within_soft_limits(q, 1e-5)),
+                    "{} seed {seed} trajectory {i}",
+                    robot.name
+                );
+                let r = check_trajectory(robot, &scene, t, &CheckConfig::default(), true).unwrap();
+                assert!(r.is_free(), "{} seed {seed} trajectory {i}: {r:?}", robot.name);
             }
             total += h.trajectories.len();
         }
-        assert!(total > 0);
+        assert!(total > 0, "{}: no trajectory", robot.name);
+    }
+
+    #[test]
+    fn harvested_trajectories_are_free_and_within_limits() {
+        harvest_is_free(&edmp_core::robot::PANDA, 0..3);
+    }
+
+    #[test]
+    fn other_arms_harvest_their_own_trajectories() {
+        harvest_is_free(&edmp_core::robot::arms::iiwa7::ROBOT, 0..2);
+        harvest_is_free(&edmp_core::robot::arms::xarm6::ROBOT, 0..2);
     }
 }

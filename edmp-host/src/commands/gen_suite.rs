@@ -102,7 +102,15 @@ pub(crate) fn solvable(family: Family, seed: u64, budget: Duration) -> Option<Pr
         budget,
         ..RrtConfig::default()
     };
-    plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene, &p.start, &p.goal, &config, seed).ok()?;
+    plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+        &edmp_core::robot::PANDA,
+        &p.scene,
+        &p.start,
+        &p.goal,
+        &config,
+        seed,
+    )
+    .ok()?;
     Some(p)
 }
 
@@ -218,9 +226,16 @@ mod tests {
                     };
                     let mut last = Err(String::new());
                     for s in seed..seed + 4 {
-                        last = plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene(), &p.start, &goal, &config, s)
-                            .map(|_| ())
-                            .map_err(|e| format!("{}: {e:?}", path.display()));
+                        last = plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+                            &edmp_core::robot::PANDA,
+                            &p.scene(),
+                            &p.start,
+                            &goal,
+                            &config,
+                            s,
+                        )
+                        .map(|_| ())
+                        .map_err(|e| format!("{}: {e:?}", path.display()));
                         if last.is_ok() {
                             break;
                         }
@@ -294,9 +309,16 @@ mod tests {
                         budget: Duration::from_secs(60),
                         ..RrtConfig::default()
                     };
-                    plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&p.scene(), &p.start, &goal, &config, seed)
-                        .map(|_| ())
-                        .map_err(|e| format!("{name}: {e:?}"))
+                    plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+                        &edmp_core::robot::PANDA,
+                        &p.scene(),
+                        &p.start,
+                        &goal,
+                        &config,
+                        seed,
+                    )
+                    .map(|_| ())
+                    .map_err(|e| format!("{name}: {e:?}"))
                 })
                 .collect();
             for r in results {

@@ -37,15 +37,21 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         budget: Duration::from_millis(args.budget_ms),
         ..RrtConfig::default()
     };
-    let planned =
-        plan::<50, { edmp_core::scene::MAX_OBSTACLES }>(&problem.scene(), &problem.start, &goal, &config, args.seed)
-            .map_err(|e| match e {
-                RrtError::Timeout => Failure::NoPath(format!("no path within {} ms", args.budget_ms)),
-                RrtError::Resample => Failure::NoPath("the resampled path cut into an obstacle".into()),
-                RrtError::InvalidStart => Failure::Input("start: in collision or outside the limits".into()),
-                RrtError::InvalidGoal => Failure::Input("goal: in collision or outside the limits".into()),
-                RrtError::Checker(e) => Failure::Input(format!("checker: {e}")),
-            })?;
+    let planned = plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+        &edmp_core::robot::PANDA,
+        &problem.scene(),
+        &problem.start,
+        &goal,
+        &config,
+        args.seed,
+    )
+    .map_err(|e| match e {
+        RrtError::Timeout => Failure::NoPath(format!("no path within {} ms", args.budget_ms)),
+        RrtError::Resample => Failure::NoPath("the resampled path cut into an obstacle".into()),
+        RrtError::InvalidStart => Failure::Input("start: in collision or outside the limits".into()),
+        RrtError::InvalidGoal => Failure::Input("goal: in collision or outside the limits".into()),
+        RrtError::Checker(e) => Failure::Input(format!("checker: {e}")),
+    })?;
     let total_ms = began.elapsed().as_secs_f64() * 1e3;
     let plan = json!({
         "format": "edmp-plan/1",

@@ -21,9 +21,9 @@ mod window_box;
 use crate::formats::json::primitive_json;
 use edmp_core::collision::checker::{CheckConfig, check_state};
 use edmp_core::rng::Rng;
-use edmp_core::robot::PANDA;
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
+use edmp_core::robot::{PANDA, Robot};
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
 pub(crate) use environment::{Environment, Region};
 use serde_json::{Value, json};
@@ -71,9 +71,6 @@ impl Family {
     }
 }
 
-/// MpiNets' neutral configuration (robofin `FrankaRobot.NEUTRAL`).
-pub(crate) const NEUTRAL: Joints<f32> = [-0.0178, -0.7601, 0.0198, -2.3421, 0.0298, 1.5412, 0.7534];
-
 /// The three MpiNets problem kinds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Kind {
@@ -119,13 +116,15 @@ pub(crate) fn environment(family: Family, rng: &mut Rng) -> Environment {
     }
 }
 
-/// A collision-free configuration reaching a random pose of `region`, tried `attempts` times.
-pub(crate) fn reach(
+/// A collision-free configuration of `robot` reaching a random pose of `region`, tried
+/// `attempts` times.
+pub(crate) fn reach<const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<MAX_OBSTACLES>,
     region: &Region,
     rng: &mut Rng,
     attempts: u32,
-) -> Option<(Joints<f32>, Pose<f32>)> {
+) -> Option<([f32; J], Pose<f32>)> {
     // The planner's 2 mm rather than the valid-end rule: generated ends keep the room the
     // committed suite was made with.
     let ik = IkConfig {
@@ -136,22 +135,24 @@ pub(crate) fn reach(
     };
     for _ in 0..attempts {
         let pose = region.sample(rng);
-        if let Ok(s) = solve(&edmp_core::robot::PANDA, &pose, &NEUTRAL, scene, &ik) {
-            let reached = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &s.joints)
-                .ok()?
-                .tcp();
+        if let Ok(s) = solve(robot, &pose, &robot.neutral, scene, &ik) {
+            let reached = *edmp_core::robot::kinematics::forward(robot, &s.joints).ok()?.tcp();
             return Some((s.joints, reached));
         }
     }
     None
 }
 
-/// `NEUTRAL + U(0, 0.25)` per joint, collision-free (MpiNets' neutral candidates).
-pub(crate) fn neutral(scene: &Scene<MAX_OBSTACLES>, rng: &mut Rng) -> Option<Joints<f32>> {
+/// `neutral + U(0, 0.25)` per joint, collision-free (MpiNets' neutral candidates).
+pub(crate) fn neutral<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    scene: &Scene<MAX_OBSTACLES>,
+    rng: &mut Rng,
+) -> Option<[f32; J]> {
     for _ in 0..50 {
-        let q: Joints<f32> =
-            core::array::from_fn(|j| (NEUTRAL[j] + rng.uniform_f32(0.0, 0.25)).min(PANDA.soft_upper[j]));
-        if check_state(&edmp_core::robot::PANDA, scene, &q, &CheckConfig::default()) == Ok(None) {
+        let q: [f32; J] =
+            core::array::from_fn(|j| (robot.neutral[j] + rng.uniform_f32(0.0, 0.25)).min(robot.soft_upper[j]));
+        if check_state(robot, scene, &q, &CheckConfig::default()) == Ok(None) {
             return Some(q);
         }
     }
@@ -178,18 +179,18 @@ pub(crate) fn problem(family: Family, kind: Kind, seed: u64) -> Option<Problem> 
     };
     let (start, goal, goal_pose) = match kind {
         Kind::TaskOriented => {
-            let (s, _) = reach(&scene, &env.regions[first], &mut rng, 20)?;
-            let (g, pose) = reach(&scene, &env.regions[second], &mut rng, 20)?;
+            let (s, _) = reach(&PANDA, &scene, &env.regions[first], &mut rng, 20)?;
+            let (g, pose) = reach(&PANDA, &scene, &env.regions[second], &mut rng, 20)?;
             (s, g, pose)
         }
         Kind::NeutralStart => {
-            let s = neutral(&scene, &mut rng)?;
-            let (g, pose) = reach(&scene, &env.regions[second], &mut rng, 20)?;
+            let s = neutral(&PANDA, &scene, &mut rng)?;
+            let (g, pose) = reach(&PANDA, &scene, &env.regions[second], &mut rng, 20)?;
             (s, g, pose)
         }
         Kind::NeutralGoal => {
-            let (s, _) = reach(&scene, &env.regions[first], &mut rng, 20)?;
-            let g = neutral(&scene, &mut rng)?;
+            let (s, _) = reach(&PANDA, &scene, &env.regions[first], &mut rng, 20)?;
+            let g = neutral(&PANDA, &scene, &mut rng)?;
             let pose = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &g)
                 .ok()?
                 .tcp();
@@ -224,18 +225,18 @@ fn targeted(
     let (start, goal, goal_pose) = match kind {
         Kind::TaskOriented => {
             let from = *others.get(rng.below(others.len().max(1) as u32) as usize)?;
-            let (s, _) = reach(&scene, from, rng, 20)?;
-            let (g, pose) = reach(&scene, &target, rng, 20)?;
+            let (s, _) = reach(&PANDA, &scene, from, rng, 20)?;
+            let (g, pose) = reach(&PANDA, &scene, &target, rng, 20)?;
             (s, g, pose)
         }
         Kind::NeutralStart => {
-            let s = neutral(&scene, rng)?;
-            let (g, pose) = reach(&scene, &target, rng, 20)?;
+            let s = neutral(&PANDA, &scene, rng)?;
+            let (g, pose) = reach(&PANDA, &scene, &target, rng, 20)?;
             (s, g, pose)
         }
         Kind::NeutralGoal => {
-            let (s, _) = reach(&scene, &target, rng, 20)?;
-            let g = neutral(&scene, rng)?;
+            let (s, _) = reach(&PANDA, &scene, &target, rng, 20)?;
+            let g = neutral(&PANDA, &scene, rng)?;
             let pose = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &g)
                 .ok()?
                 .tcp();
