@@ -43,6 +43,9 @@ pub struct ArmSpec {
     /// neutral ends), one value per actuated joint in URDF order: the gripper pointing down in
     /// front of the base, elbow up.
     pub neutral: &'static [f64],
+    /// The folder of its trained prior (`prior.safetensors`, `prior.json`), relative to the
+    /// repository root; `None` until one is trained.
+    pub prior: Option<&'static str>,
 }
 
 /// Every arm, the Panda first.
@@ -57,6 +60,7 @@ pub const ARMS: [ArmSpec; 3] = [
         pairs: PairRule::Levels,
         // MpiNets' neutral configuration (robofin `FrankaRobot.NEUTRAL`).
         neutral: &[-0.0178, -0.7601, 0.0198, -2.3421, 0.0298, 1.5412, 0.7534],
+        prior: Some("weights/prior"),
     },
     // KUKA LBR iiwa 7 (pybullet_data/kuka_iiwa): 7 revolute joints, one STL hull per link,
     // no tool flange link, so the TCP and the hand are the last link.
@@ -70,6 +74,7 @@ pub const ARMS: [ArmSpec; 3] = [
         pairs: PairRule::ApartAtZero,
         // Flange at about (0.43, 0, 0.46) m, pointing down (q2 - q4 + q6 ≈ π).
         neutral: &[0.0, 0.2, 0.0, -2.0, 0.0, 0.95, 0.0],
+        prior: Some("weights/iiwa7"),
     },
     // UFACTORY xArm 6 (pybullet_data/xarm): 6 revolute joints under a geometry-free `world`
     // root, V-HACD collision meshes (several convex pieces per link).
@@ -83,6 +88,7 @@ pub const ARMS: [ArmSpec; 3] = [
         pairs: PairRule::ApartAtZero,
         // Flange at about (0.34, 0, 0.43) m, pointing down.
         neutral: &[0.0, -0.5, -0.8, 0.0, 1.3, 0.0],
+        prior: Some("weights/xarm6"),
     },
 ];
 

@@ -106,7 +106,7 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
 /// What [`generate_prior`] produces: the Rust source and the weight blob it `include_bytes!`s.
 #[derive(Clone, Debug)]
 pub struct GeneratedPrior {
-    /// Rust source to `include!`; it reads `OUT_DIR/prior.bin`.
+    /// Rust source to `include!`; it reads the blob from `OUT_DIR/` under the name given.
     pub source: String,
     /// The int8 weights, in the order the source's offsets name.
     pub blob: Vec<u8>,
@@ -289,7 +289,8 @@ fn read_config(path: &Path) -> Result<Config, String> {
 
 /// Reads `dir/prior.safetensors` and `dir/prior.json` and returns the generated prior.
 /// `display` names the directory in the generated comments.
-pub fn generate_prior(dir: &Path, display: &str) -> Result<GeneratedPrior, String> {
+/// The source `include_bytes!`s the blob from `OUT_DIR/{blob}`.
+pub fn generate_prior(dir: &Path, display: &str, blob: &str) -> Result<GeneratedPrior, String> {
     let json = dir.join("prior.json");
     let weights = dir.join("prior.safetensors");
     let cfg = read_config(&json)?;
@@ -452,7 +453,7 @@ pub fn generate_prior(dir: &Path, display: &str) -> Result<GeneratedPrior, Strin
     let _ = writeln!(s);
     let _ = writeln!(
         s,
-        "static WEIGHTS: Aligned<[u8; WEIGHT_BYTES]> = Aligned(*include_bytes!(concat!(env!(\"OUT_DIR\"), \"/prior.bin\")));"
+        "static WEIGHTS: Aligned<[u8; WEIGHT_BYTES]> = Aligned(*include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{blob}\")));"
     );
     let _ = writeln!(s);
     let _ = writeln!(s, "/// The weight blob (int8 stored as bytes).");

@@ -93,7 +93,7 @@ fn safetensors_round_trip_and_refusals() {
 
 #[test]
 fn committed_weights_generate_tables_whose_blob_requantizes_exactly() {
-    let generated = generate_prior(&prior_dir(), "weights/prior").expect("the committed prior generates");
+    let generated = generate_prior(&prior_dir(), "weights/prior", "prior.bin").expect("the committed prior generates");
     let tensors = read_safetensors(&prior_dir().join("prior.safetensors")).unwrap();
     // Every conv/linear weight is in the blob once, as int8.
     let quantized: usize = tensors
@@ -133,7 +133,7 @@ fn a_network_that_disagrees_with_its_json_is_refused() {
     let mut bad = v.clone();
     bad["dims"] = serde_json::json!(dims.iter().map(|d| d * 2).collect::<Vec<_>>());
     std::fs::write(dir.join("prior.json"), bad.to_string()).unwrap();
-    let err = generate_prior(&dir, "tmp").unwrap_err();
+    let err = generate_prior(&dir, "tmp", "prior.bin").unwrap_err();
     assert!(err.contains("has shape"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

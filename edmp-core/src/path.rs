@@ -12,5 +12,8 @@ pub const HORIZON: usize = 50;
 /// A trajectory of `H` waypoints of the arm's joints.
 pub type Trajectory<const H: usize> = [[f32; JOINTS]; H];
 
-/// A planned path: [`HORIZON`] waypoints.
+/// A planned path: [`HORIZON`] waypoints of the Panda's joints.
 pub type Path = Trajectory<HORIZON>;
+
+/// A planned path of an arm with `J` joints: [`HORIZON`] waypoints.
+pub type PathOf<const J: usize> = [[f32; J]; HORIZON];

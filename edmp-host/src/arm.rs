@@ -40,6 +40,11 @@ impl Arm {
     }
 }
 
+/// The error for an arm whose prior is not trained yet.
+pub fn untrained(arm: Arm) -> String {
+    format!("{arm}: no trained prior yet (weights/README.md: `gen-data --robot {arm}`, then train.py)")
+}
+
 impl fmt::Display for Arm {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -48,9 +53,33 @@ impl fmt::Display for Arm {
 
 /// `with_arm!(arm, robot => expr)`: evaluates `expr` with `robot` bound to the arm's `f32`
 /// tables (`&'static Robot<f32, J>`, each arm its own `J`), so generic code runs for the
-/// arm named at run time.
+/// arm named at run time. `with_arm!(arm, robot, network => expr)` also binds `network` to
+/// the arm's trained prior (`&'static Network<J>`), or returns an error naming the arm from
+/// the enclosing `Result<_, String>` function when it has none yet.
 #[macro_export]
 macro_rules! with_arm {
+    ($arm:expr, $robot:ident, $network:ident => $body:expr) => {
+        match $arm {
+            $crate::arm::Arm::Panda => {
+                let ($robot, $network) = (&edmp_core::robot::arms::panda::ROBOT, edmp_core::prior::PANDA);
+                $body
+            }
+            $crate::arm::Arm::Iiwa7 => {
+                let $robot = &edmp_core::robot::arms::iiwa7::ROBOT;
+                let Some($network) = edmp_core::prior::arms::iiwa7::NETWORK else {
+                    return Err($crate::arm::untrained($crate::arm::Arm::Iiwa7));
+                };
+                $body
+            }
+            $crate::arm::Arm::Xarm6 => {
+                let $robot = &edmp_core::robot::arms::xarm6::ROBOT;
+                let Some($network) = edmp_core::prior::arms::xarm6::NETWORK else {
+                    return Err($crate::arm::untrained($crate::arm::Arm::Xarm6));
+                };
+                $body
+            }
+        }
+    };
     ($arm:expr, $robot:ident => $body:expr) => {
         match $arm {
             $crate::arm::Arm::Panda => {

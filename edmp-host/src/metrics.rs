@@ -19,7 +19,7 @@ pub(crate) struct Roughness {
 }
 
 /// The L2 norm of one step in joint space.
-pub(crate) fn step_norm(a: &Joints<f32>, b: &Joints<f32>) -> f64 {
+pub(crate) fn step_norm<const J: usize>(a: &[f32; J], b: &[f32; J]) -> f64 {
     a.iter()
         .zip(b)
         .map(|(x, y)| f64::from(x - y).powi(2))
@@ -28,7 +28,7 @@ pub(crate) fn step_norm(a: &Joints<f32>, b: &Joints<f32>) -> f64 {
 }
 
 /// Roughness of a trajectory of at least three waypoints (fewer: all zero).
-pub(crate) fn roughness(path: &[Joints<f32>]) -> Roughness {
+pub(crate) fn roughness<const J: usize>(path: &[[f32; J]]) -> Roughness {
     if path.len() < 3 {
         return Roughness::default();
     }

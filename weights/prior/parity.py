@@ -1,6 +1,8 @@
 """Write the parity fixture the Rust int8 network is tested against.
 
     python3 weights/prior/parity.py --data data.npy
+    python3 weights/prior/parity.py --data iiwa7.npy --weights weights/iiwa7 \
+        --out tests/fixtures/prior_parity_iiwa7.json
 
 For fixed inputs (several t; x_t made from held-out trajectories as in training, and pure noise)
 it records the float model's epsilon and the fake-quantized model's (int8 weights * scale, float
@@ -58,10 +60,10 @@ def main():
         xt[:, :, 0], xt[:, :, -1] = x0[:, :, 0], x0[:, :, -1]
         cases.append((t, xt))
     for t in (255, 128, 3):
-        xt = torch.randn(1, 7, 50)
+        xt = torch.randn(1, model.joints, 50)
         cases.append((t, xt))
 
-    out = {"seed": args.seed, "note": "x and eps are waypoint-major (50 x 7); regenerate with weights/prior/parity.py", "cases": []}
+    out = {"seed": args.seed, "note": f"x and eps are waypoint-major (50 x {model.joints}); regenerate with weights/prior/parity.py", "cases": []}
     worst_q, worst_scale = 0.0, 0.0
     with torch.no_grad():
         for t, xt in cases:

@@ -8,15 +8,16 @@
 //! strided steps, for comparison. All write the start and the goal into the first and last
 //! waypoint after every step.
 
+pub mod arms;
 mod layers;
 mod net;
 mod weights;
 
-pub use net::{Scratch, TimeEmbedding, predict_noise, predict_noise_on};
+pub use net::{Network, Scratch, TimeEmbedding, predict_noise, predict_noise_on};
 pub use weights::{DIMS, LENGTHS, LEVELS, MACS, PARAMETERS, STEPS, WEIGHT_BYTES, WEIGHTS_FNV1A};
 
 use crate::Error;
-use crate::path::{HORIZON, Path};
+use crate::path::{HORIZON, Path, PathOf};
 use crate::rng::Rng;
 use crate::robot::JOINTS;
 
@@ -27,17 +28,17 @@ const _: () = assert!(
 );
 const _: () = assert!(LENGTHS[0] == HORIZON, "weights/prior was trained for another horizon");
 
-/// The weight blob the build embedded: `include_bytes!` of the codegen output.
+/// The Panda's network.
+pub static PANDA: &Network<JOINTS> = &weights::NETWORK;
+
+/// The weight blob the build embedded for the Panda: `include_bytes!` of the codegen output.
 pub fn weight_blob() -> &'static [u8] {
-    weights::WEIGHT_BLOB
+    PANDA.weight_blob()
 }
 
-/// Whether the embedded weights still hash to the checksum codegen computed (flash check).
+/// Whether the Panda's embedded weights still hash to the checksum codegen computed.
 pub fn weights_intact() -> bool {
-    let h = weight_blob().iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3)
-    });
-    h == WEIGHTS_FNV1A
+    PANDA.weights_intact()
 }
 
 /// How to walk from noise to a trajectory.
@@ -101,14 +102,14 @@ impl Sampler {
     /// Moves `x` from step `step.t` to `step.prev` given the network's `eps` (the noise draw
     /// comes from `rng`, one normal per entry, waypoint-major). Then re-inpaints: the start/goal
     /// conditioning of EDMP.
-    pub fn update(
+    pub fn update<const J: usize>(
         &self,
         step: Step,
-        x: &mut Path,
-        eps: &Path,
+        x: &mut PathOf<J>,
+        eps: &PathOf<J>,
         rng: &mut Rng,
-        start: &[f32; JOINTS],
-        goal: &[f32; JOINTS],
+        start: &[f32; J],
+        goal: &[f32; J],
     ) {
         self.advance(step, x, eps, rng);
         inpaint(x, start, goal);
@@ -116,7 +117,7 @@ impl Sampler {
 
     /// [`Self::update`] without the inpainting: every waypoint, the ends included, follows the
     /// network (the paper's "without conditioning" ablation, Table IV).
-    pub fn advance(&self, step: Step, x: &mut Path, eps: &Path, rng: &mut Rng) {
+    pub fn advance<const J: usize>(&self, step: Step, x: &mut PathOf<J>, eps: &PathOf<J>, rng: &mut Rng) {
         let i = table_index(step.t);
         match *self {
             Self::Ancestral => {
@@ -190,7 +191,7 @@ impl Step {
 /// The forward process q(x_t | x_0): `x ← √ᾱ_t·x + √(1−ᾱ_t)·ε` (standard normals from `rng`,
 /// waypoint-major), then the ends written in: how a trajectory found elsewhere is handed to the
 /// prior at an intermediate step (SDEdit), to be denoised from there.
-pub fn diffuse(x: &mut Path, t: u16, rng: &mut Rng, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
+pub fn diffuse<const J: usize>(x: &mut PathOf<J>, t: u16, rng: &mut Rng, start: &[f32; J], goal: &[f32; J]) {
     let i = table_index(t);
     let (a, n) = (weights::SQRT_ALPHA_BAR[i], weights::SQRT_ONE_MINUS_ALPHA_BAR[i]);
     for v in x.iter_mut().flatten() {
@@ -206,13 +207,13 @@ fn table_index(t: u16) -> usize {
 }
 
 /// Writes the start and the goal into the first and last waypoints.
-pub fn inpaint(x: &mut Path, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
+pub fn inpaint<const J: usize>(x: &mut PathOf<J>, start: &[f32; J], goal: &[f32; J]) {
     x[0] = *start;
     x[HORIZON - 1] = *goal;
 }
 
 /// The sampler's starting point: standard normal entries (waypoint-major), then inpainted.
-pub fn initial_noise(x: &mut Path, rng: &mut Rng, start: &[f32; JOINTS], goal: &[f32; JOINTS]) {
+pub fn initial_noise<const J: usize>(x: &mut PathOf<J>, rng: &mut Rng, start: &[f32; J], goal: &[f32; J]) {
     for v in x.iter_mut().flatten() {
         *v = rng.normal_f32();
     }
@@ -221,7 +222,7 @@ pub fn initial_noise(x: &mut Path, rng: &mut Rng, start: &[f32; JOINTS], goal: &
 
 /// Redraws the two ends of an [`initial_noise`] as standard normals (a second, independent
 /// draw): the starting point of the unconditioned ablation.
-pub fn free_ends(x: &mut Path, rng: &mut Rng) {
+pub fn free_ends<const J: usize>(x: &mut PathOf<J>, rng: &mut Rng) {
     for w in [0, HORIZON - 1] {
         for v in x[w].iter_mut() {
             *v = rng.normal_f32();
@@ -230,7 +231,7 @@ pub fn free_ends(x: &mut Path, rng: &mut Rng) {
 }
 
 /// A joint vector with a NaN or an infinity is a typed error naming the joint.
-pub(crate) fn check_joints(q: &[f32; JOINTS]) -> Result<(), Error> {
+pub(crate) fn check_joints<const J: usize>(q: &[f32; J]) -> Result<(), Error> {
     match q.iter().position(|v| !v.is_finite()) {
         Some(joint) => Err(Error::NonFiniteJoint { joint: joint as u8 }),
         None => Ok(()),
@@ -263,6 +264,21 @@ pub fn sample_conditioned<const B: usize, const C: usize>(
     scratch: &mut Scratch<C>,
     out: &mut [Path; B],
 ) -> Result<(), Error> {
+    sample_with(PANDA, sampler, condition, start, goal, rng, scratch, out)
+}
+
+/// [`sample_conditioned`] with `network`: any arm's prior.
+#[allow(clippy::too_many_arguments)]
+pub fn sample_with<const J: usize, const B: usize, const C: usize>(
+    network: &Network<J>,
+    sampler: Sampler,
+    condition: bool,
+    start: &[f32; J],
+    goal: &[f32; J],
+    rng: &mut Rng,
+    scratch: &mut Scratch<C>,
+    out: &mut [PathOf<J>; B],
+) -> Result<(), Error> {
     sampler.validate()?;
     check_joints(start)?;
     check_joints(goal)?;
@@ -272,11 +288,11 @@ pub fn sample_conditioned<const B: usize, const C: usize>(
             free_ends(x, rng);
         }
     }
-    let mut eps = [[[0.0f32; JOINTS]; HORIZON]; B];
+    let mut eps = [[[0.0f32; J]; HORIZON]; B];
     for j in 0..sampler.evaluations() {
         let step = sampler.step(j);
-        let time = TimeEmbedding::new(step.t)?;
-        predict_noise(out, &time, scratch, &mut eps)?;
+        let time = network.time(step.t)?;
+        network.predict_noise(out, &time, scratch, &mut eps)?;
         for (x, e) in out.iter_mut().zip(&eps) {
             if condition {
                 sampler.update(step, x, e, rng, start, goal);

@@ -11,12 +11,140 @@
 //! register tiles of 4 channels × 8 positions without branches, and only the row's end wastes
 //! work.
 
-use super::layers::{Conv, ConvBlock, Linear, ResBlock};
-use super::weights::{DIMS, GROUPS, KERNEL, LENGTHS, LEVELS, NET, STEPS, TIME_DIM, TIME_HIDDEN, TOP_SKIP};
+use super::layers::{Conv, ConvBlock, Linear, Net, ResBlock};
+use super::weights::{DIMS, GROUPS, KERNEL, LENGTHS, LEVELS, NETWORK, STEPS, TIME_DIM, TIME_HIDDEN, TOP_SKIP};
 use crate::Error;
 use crate::executor::{Executor, MAX_PARTS, split};
 use crate::path::Trajectory;
 use crate::robot::JOINTS;
+
+/// One arm's trained network: its layer table and weight blob, for trajectories of `J` joints.
+/// Every arm's network has the Panda's shape but for the input and output channels (checked
+/// where each is declared), so one [`Scratch`] serves them all.
+pub struct Network<const J: usize> {
+    /// The scene format's `robot` name of the arm it was trained for.
+    pub name: &'static str,
+    pub(crate) net: &'static Net,
+    pub(crate) blob: &'static [u8],
+    pub(crate) fnv1a: u64,
+}
+
+impl<const J: usize> core::fmt::Debug for Network<J> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "Network<{J}>({}, {} weight bytes)", self.name, self.blob.len())
+    }
+}
+
+impl<const J: usize> Network<J> {
+    /// The weight blob the build embedded: `include_bytes!` of the codegen output.
+    pub fn weight_blob(&self) -> &'static [u8] {
+        self.blob
+    }
+
+    /// Whether the embedded weights still hash to the checksum codegen computed (flash check).
+    pub fn weights_intact(&self) -> bool {
+        let h = self.blob.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3)
+        });
+        h == self.fnv1a
+    }
+
+    /// This network's embedding of step `t` (1 ..= `STEPS`, as the network was trained).
+    pub fn time(&self, t: u16) -> Result<TimeEmbedding, Error> {
+        TimeEmbedding::of(self.net, t)
+    }
+
+    /// [`predict_noise`] with this network; `time` must come from [`Self::time`].
+    pub fn predict_noise<const B: usize, const C: usize>(
+        &self,
+        x: &[[[f32; J]; LENGTHS[0]]; B],
+        time: &TimeEmbedding,
+        scratch: &mut Scratch<C>,
+        eps: &mut [[[f32; J]; LENGTHS[0]]; B],
+    ) -> Result<(), Error> {
+        check_finite(x)?;
+        if C == 0 || J > JOINTS {
+            return Err(Error::BadParameter);
+        }
+        for (x, eps) in x.chunks(C).zip(eps.chunks_mut(C)) {
+            forward(self.net, x, time, scratch, eps);
+        }
+        finite_or_overflow(eps)
+    }
+
+    /// [`predict_noise_on`] with this network; `time` must come from [`Self::time`].
+    pub fn predict_noise_on<E: Executor, const C: usize>(
+        &self,
+        exec: &E,
+        x: &[[[f32; J]; LENGTHS[0]]],
+        time: &TimeEmbedding,
+        scratches: &mut [Scratch<C>],
+        eps: &mut [[[f32; J]; LENGTHS[0]]],
+    ) -> Result<(), Error> {
+        check_finite(x)?;
+        if C == 0 || J > JOINTS || scratches.is_empty() || x.len() != eps.len() {
+            return Err(Error::BadParameter);
+        }
+        struct Part<'a, const J: usize, const C: usize> {
+            x: &'a [[[f32; J]; LENGTHS[0]]],
+            eps: &'a mut [[[f32; J]; LENGTHS[0]]],
+            scratch: &'a mut Scratch<C>,
+        }
+        let lens = split(x.len(), C, exec.parts().min(scratches.len()));
+        let mut parts: heapless::Vec<Part<'_, J, C>, MAX_PARTS> = heapless::Vec::new();
+        let (mut x_rest, mut eps_rest) = (x, &mut eps[..]);
+        for (&len, scratch) in lens.iter().zip(scratches.iter_mut()) {
+            if len == 0 {
+                break;
+            }
+            let (Some((xp, xr)), Some((ep, er))) = (
+                x_rest.split_at_checked(len),
+                core::mem::take(&mut eps_rest).split_at_mut_checked(len),
+            ) else {
+                return Err(Error::BadParameter);
+            };
+            (x_rest, eps_rest) = (xr, er);
+            if parts
+                .push(Part {
+                    x: xp,
+                    eps: ep,
+                    scratch,
+                })
+                .is_err()
+            {
+                return Err(Error::BadParameter);
+            }
+        }
+        let net = self.net;
+        exec.each(&mut parts, |part| {
+            for (x, eps) in part.x.chunks(C).zip(part.eps.chunks_mut(C)) {
+                forward(net, x, time, part.scratch, eps);
+            }
+            Ok(())
+        })?;
+        drop(parts);
+        finite_or_overflow(eps)
+    }
+}
+
+/// A non-finite input is an error naming its joint.
+fn check_finite<const J: usize, const L: usize>(x: &[[[f32; J]; L]]) -> Result<(), Error> {
+    for waypoint in x.iter().flatten() {
+        if let Some(joint) = waypoint.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFiniteJoint { joint: joint as u8 });
+        }
+    }
+    Ok(())
+}
+
+/// An output that overflowed is [`Error::Overflow`].
+fn finite_or_overflow<const J: usize, const L: usize>(eps: &[[[f32; J]; L]]) -> Result<(), Error> {
+    if eps.iter().flatten().flatten().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::Overflow)
+    }
+}
 
 /// Zero columns on each side of an activation row.
 const PAD: usize = KERNEL / 2;
@@ -108,8 +236,13 @@ pub struct TimeEmbedding {
 }
 
 impl TimeEmbedding {
-    /// The embedding of step `t` (1 ..= `STEPS`, as the network was trained).
+    /// The Panda network's embedding of step `t` (1 ..= `STEPS`, as the network was trained);
+    /// other arms' come from [`Network::time`].
     pub fn new(t: u16) -> Result<Self, Error> {
+        NETWORK.time(t)
+    }
+
+    fn of(net: &Net, t: u16) -> Result<Self, Error> {
         if t == 0 || usize::from(t) > STEPS {
             return Err(Error::BadParameter);
         }
@@ -122,10 +255,10 @@ impl TimeEmbedding {
             sinusoid[half + i] = libm::cosf(arg);
         }
         let mut hidden = [0.0f32; TIME_HIDDEN];
-        linear(&NET.time_in, &sinusoid, &mut hidden);
+        linear(&net.time_in, &sinusoid, &mut hidden);
         hidden.iter_mut().for_each(|h| *h = mish(*h));
         let mut features = [0.0f32; TIME_DIM];
-        linear(&NET.time_out, &hidden, &mut features);
+        linear(&net.time_out, &hidden, &mut features);
         features.iter_mut().for_each(|h| *h = mish(*h));
         Ok(Self { t, features })
     }
@@ -183,22 +316,7 @@ pub fn predict_noise<const B: usize, const C: usize>(
     scratch: &mut Scratch<C>,
     eps: &mut [Trajectory<{ LENGTHS[0] }>; B],
 ) -> Result<(), Error> {
-    for waypoint in x.iter().flatten() {
-        if let Some(joint) = waypoint.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFiniteJoint { joint: joint as u8 });
-        }
-    }
-    if C == 0 {
-        return Err(Error::BadParameter);
-    }
-    for (x, eps) in x.chunks(C).zip(eps.chunks_mut(C)) {
-        forward(x, time, scratch, eps);
-    }
-    if eps.iter().flatten().flatten().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(Error::Overflow)
-    }
+    NETWORK.predict_noise(x, time, scratch, eps)
 }
 
 /// [`predict_noise`] with the batch cut into parts, one per scratch (at most
@@ -212,64 +330,16 @@ pub fn predict_noise_on<E: Executor, const C: usize>(
     scratches: &mut [Scratch<C>],
     eps: &mut [Trajectory<{ LENGTHS[0] }>],
 ) -> Result<(), Error> {
-    for waypoint in x.iter().flatten() {
-        if let Some(joint) = waypoint.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFiniteJoint { joint: joint as u8 });
-        }
-    }
-    if C == 0 || scratches.is_empty() || x.len() != eps.len() {
-        return Err(Error::BadParameter);
-    }
-    struct Part<'a, const C: usize> {
-        x: &'a [Trajectory<{ LENGTHS[0] }>],
-        eps: &'a mut [Trajectory<{ LENGTHS[0] }>],
-        scratch: &'a mut Scratch<C>,
-    }
-    let lens = split(x.len(), C, exec.parts().min(scratches.len()));
-    let mut parts: heapless::Vec<Part<'_, C>, MAX_PARTS> = heapless::Vec::new();
-    let (mut x_rest, mut eps_rest) = (x, &mut eps[..]);
-    for (&len, scratch) in lens.iter().zip(scratches.iter_mut()) {
-        if len == 0 {
-            break;
-        }
-        let (Some((xp, xr)), Some((ep, er))) = (
-            x_rest.split_at_checked(len),
-            core::mem::take(&mut eps_rest).split_at_mut_checked(len),
-        ) else {
-            return Err(Error::BadParameter);
-        };
-        (x_rest, eps_rest) = (xr, er);
-        if parts
-            .push(Part {
-                x: xp,
-                eps: ep,
-                scratch,
-            })
-            .is_err()
-        {
-            return Err(Error::BadParameter);
-        }
-    }
-    exec.each(&mut parts, |part| {
-        for (x, eps) in part.x.chunks(C).zip(part.eps.chunks_mut(C)) {
-            forward(x, time, part.scratch, eps);
-        }
-        Ok(())
-    })?;
-    drop(parts);
-    if eps.iter().flatten().flatten().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(Error::Overflow)
-    }
+    NETWORK.predict_noise_on(exec, x, time, scratches, eps)
 }
 
 /// One chunk of at most `C` trajectories through the network.
-fn forward<const C: usize>(
-    x: &[Trajectory<{ LENGTHS[0] }>],
+fn forward<const J: usize, const C: usize>(
+    net: &Net,
+    x: &[[[f32; J]; LENGTHS[0]]],
     time: &TimeEmbedding,
     scratch: &mut Scratch<C>,
-    eps: &mut [Trajectory<{ LENGTHS[0] }>],
+    eps: &mut [[[f32; J]; LENGTHS[0]]],
 ) {
     let batch = x.len();
     let temb = &time.features;
@@ -284,7 +354,7 @@ fn forward<const C: usize>(
 
     // Input: channels first, zero pads.
     let top = Layout { batch, len: LENGTHS[0] };
-    x_buf[..JOINTS * top.row()].fill(0.0);
+    x_buf[..J * top.row()].fill(0.0);
     for (b, trajectory) in x.iter().enumerate() {
         for (l, waypoint) in trajectory.iter().enumerate() {
             for (j, v) in waypoint.iter().enumerate() {
@@ -294,8 +364,8 @@ fn forward<const C: usize>(
     }
 
     let mut skip_offset = 0;
-    let mut channels = JOINTS;
-    for (i, level) in NET.down.iter().enumerate() {
+    let mut channels = J;
+    for (i, level) in net.down.iter().enumerate() {
         let lay = Layout { batch, len: LENGTHS[i] };
         res_block(&level.res0, x_buf, lay, temb, h_buf, y_buf, wbuf);
         core::mem::swap(&mut x_buf, &mut y_buf);
@@ -326,12 +396,12 @@ fn forward<const C: usize>(
         batch,
         len: LENGTHS[LEVELS - 1],
     };
-    res_block(&NET.mid0, x_buf, deepest, temb, h_buf, y_buf, wbuf);
+    res_block(&net.mid0, x_buf, deepest, temb, h_buf, y_buf, wbuf);
     core::mem::swap(&mut x_buf, &mut y_buf);
-    res_block(&NET.mid1, x_buf, deepest, temb, h_buf, y_buf, wbuf);
+    res_block(&net.mid1, x_buf, deepest, temb, h_buf, y_buf, wbuf);
     core::mem::swap(&mut x_buf, &mut y_buf);
 
-    for (j, level) in NET.up.iter().enumerate() {
+    for (j, level) in net.up.iter().enumerate() {
         let i = LEVELS - 1 - j;
         let lay = Layout { batch, len: LENGTHS[i] };
         // Concatenate [x, skip_i] on channels: the skip's rows follow x's.
@@ -359,8 +429,8 @@ fn forward<const C: usize>(
         let n = channels * top.row();
         x_buf[n..2 * n].copy_from_slice(&skips[..n]);
     }
-    conv_block(&NET.final_block, x_buf, top, y_buf, wbuf);
-    conv_same(&NET.out, y_buf, top, h_buf, Accumulate::Overwrite, wbuf);
+    conv_block(&net.final_block, x_buf, top, y_buf, wbuf);
+    conv_same(&net.out, y_buf, top, h_buf, Accumulate::Overwrite, wbuf);
     for (b, trajectory) in eps.iter_mut().enumerate() {
         for (l, waypoint) in trajectory.iter_mut().enumerate() {
             for (j, v) in waypoint.iter_mut().enumerate() {

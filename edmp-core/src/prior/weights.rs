@@ -10,5 +10,14 @@
 )]
 
 use super::layers::{Aligned, Conv, ConvBlock, Down, Linear, Net, ResBlock, Up, slice_of};
+use super::net::Network;
 
 include!(concat!(env!("OUT_DIR"), "/prior.rs"));
+
+/// The Panda's network (`weights/prior/`).
+pub static NETWORK: Network<JOINTS> = Network {
+    name: "panda",
+    net: &NET,
+    blob: WEIGHT_BLOB,
+    fnv1a: WEIGHTS_FNV1A,
+};

@@ -5,9 +5,11 @@
 //! configurations (IK solutions of poses in its target volumes, and neutral configurations),
 //! and every pair of candidates is planned with RRT-Connect (1 s budget): a path from `a` to
 //! `b` is also, reversed, a path from `b` to `a` (kept when the checker, walking it that way,
-//! agrees), so each success gives up to two trajectories, as MpiNets' 7 × 7 pairs do. Every trajectory is 50 × 7 radians, within the soft limits and
-//! collision-free by the exact checker with 0.01 rad interpolation (the planner checks it).
-//! Output: one `.npy` file, float32, shape (count, 50, 7), which `numpy.load` reads as is.
+//! agrees), so each success gives up to two trajectories, as MpiNets' 7 × 7 pairs do. Every
+//! trajectory is 50 waypoints of the arm's joints (`--robot`; the candidates are its IK
+//! solutions and its neutral configuration), within its limits and collision-free by the exact
+//! checker with 0.01 rad interpolation (the planner checks it).
+//! Output: one `.npy` file, float32, shape (count, 50, J), which `numpy.load` reads as is.
 
 use crate::arm::{Arm, with_arm};
 use crate::rrt::{RrtConfig, path_length, plan};

@@ -4,16 +4,19 @@
 //! excluding the first and last segment, RF2W first segment, RL2W last), the share of
 //! trajectories leaving the hard joint limits or colliding with the robot itself (exact
 //! checker, empty scene), and the sampling time. `--data` adds the same row for the training
-//! trajectories; `--plot` draws some samples, joint by joint, to a PNG.
+//! trajectories; `--plot` draws some samples, joint by joint, to a PNG. `--robot` measures
+//! another arm's prior; `--ends-from-data` takes the start/goal pairs from the held-out
+//! training trajectories instead of a suite (an arm without suites yet).
 
+use crate::arm::{Arm, with_arm};
 use crate::commands::render::Canvas;
 use crate::formats::json::{Goal, read_problem};
 use crate::metrics::{Roughness, roughness, step_norm};
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
-use edmp_core::path::{HORIZON, Path};
-use edmp_core::prior::{Sampler, Scratch, sample_conditioned};
+use edmp_core::path::{HORIZON, PathOf};
+use edmp_core::prior::{Network, Sampler, Scratch, sample_with};
 use edmp_core::rng::Rng;
-use edmp_core::robot::{JOINTS, PANDA};
+use edmp_core::robot::Robot;
 use edmp_core::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -53,6 +56,13 @@ pub struct Args {
     /// denoising, ends written at the end): the paper's Table IV ablation.
     #[arg(long)]
     no_conditioning: bool,
+    /// The arm whose prior to measure (docs/formats.md, "Other arms").
+    #[arg(long, value_enum, default_value_t = Arm::Panda)]
+    robot: Arm,
+    /// Start/goal pairs from the ends of the last `--per-family` × 4 held-out trajectories of
+    /// `--data` instead of the `--problems` suite.
+    #[arg(long, requires = "data")]
+    ends_from_data: bool,
 }
 
 fn parse_sampler(s: &str) -> Result<Sampler, String> {
@@ -96,17 +106,16 @@ struct Quality {
     self_colliding: bool,
 }
 
-fn quality(x: &Path, empty: &Scene<1>) -> Quality {
+fn quality<const J: usize>(robot: &'static Robot<f32, J>, x: &PathOf<J>, empty: &Scene<1>) -> Quality {
     let outside_limits = x.iter().flatten().enumerate().any(|(i, v)| {
-        let j = i % JOINTS;
-        *v < PANDA.hard_lower[j] || *v > PANDA.hard_upper[j]
+        let j = i % J;
+        *v < robot.hard_lower[j] || *v > robot.hard_upper[j]
     });
     let config = CheckConfig {
         self_collision: true,
         ..CheckConfig::default()
     };
-    let self_colliding =
-        check_trajectory(&edmp_core::robot::PANDA, empty, x, &config, true).map_or(true, |r| !r.is_free());
+    let self_colliding = check_trajectory(robot, empty, x, &config, true).map_or(true, |r| !r.is_free());
     Quality {
         roughness: roughness(x),
         outside_limits,
@@ -131,11 +140,11 @@ fn row(label: &str, q: &[Quality], ms: Option<(f64, f64)>) -> String {
     )
 }
 
-fn read_npy(path: &std::path::Path) -> Result<Vec<Path>, String> {
+fn read_npy<const J: usize>(path: &std::path::Path) -> Result<Vec<PathOf<J>>, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let bad = || {
         format!(
-            "{}: not a float32 (N, {HORIZON}, {JOINTS}) .npy from gen-data",
+            "{}: not a float32 (N, {HORIZON}, {J}) .npy from gen-data",
             path.display()
         )
     };
@@ -144,17 +153,17 @@ fn read_npy(path: &std::path::Path) -> Result<Vec<Path>, String> {
     }
     let header_len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
     let header = core::str::from_utf8(bytes.get(10..10 + header_len).ok_or_else(bad)?).map_err(|_| bad())?;
-    if !header.contains("'<f4'") || !header.contains(&format!(", {HORIZON}, {JOINTS})")) {
+    if !header.contains("'<f4'") || !header.contains(&format!(", {HORIZON}, {J})")) {
         return Err(bad());
     }
     let data = &bytes[10 + header_len..];
-    let per = HORIZON * JOINTS * 4;
+    let per = HORIZON * J * 4;
     Ok(data
         .chunks_exact(per)
         .map(|t| {
             core::array::from_fn(|w| {
                 core::array::from_fn(|j| {
-                    let i = (w * JOINTS + j) * 4;
+                    let i = (w * J + j) * 4;
                     f32::from_le_bytes([t[i], t[i + 1], t[i + 2], t[i + 3]])
                 })
             })
@@ -168,6 +177,10 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 
 /// Runs the measurement and prints the table.
 pub fn run(args: &Args) -> Result<(), String> {
+    with_arm!(args.robot, robot, network => measure(robot, network, args))
+}
+
+fn measure<const J: usize>(robot: &'static Robot<f32, J>, network: &Network<J>, args: &Args) -> Result<(), String> {
     let samplers = args
         .samplers
         .iter()
@@ -176,14 +189,32 @@ pub fn run(args: &Args) -> Result<(), String> {
     if samplers.is_empty() {
         return Err("--samplers: give at least one".into());
     }
-    let mut problems = Vec::new();
-    for (_, files) in crate::commands::gen_suite::read_folder(&args.problems, args.per_family)? {
-        for path in files {
-            let p = read_problem(&path)?;
-            let Goal::Joints(goal) = p.goal else {
-                return Err(format!("{}: suite problems have joint goals", path.display()));
-            };
-            problems.push((p.start, goal));
+    let data = match &args.data {
+        Some(path) => read_npy::<J>(path)?,
+        None => Vec::new(),
+    };
+    let held = &data[data.len().saturating_sub(1200)..];
+    let mut problems: Vec<([f32; J], [f32; J])> = Vec::new();
+    if args.ends_from_data {
+        problems.extend(held.iter().take(4 * args.per_family).map(|x| (x[0], x[HORIZON - 1])));
+    } else if args.robot != Arm::Panda {
+        return Err(format!(
+            "--robot {}: the suites are the Panda's; give --data and --ends-from-data",
+            robot.name
+        ));
+    } else {
+        for (_, files) in crate::commands::gen_suite::read_folder(&args.problems, args.per_family)? {
+            for path in files {
+                let p = read_problem(&path)?;
+                let Goal::Joints(goal) = p.goal else {
+                    return Err(format!("{}: suite problems have joint goals", path.display()));
+                };
+                let (Ok(start), Ok(goal)) = (<[f32; J]>::try_from(&p.start[..]), <[f32; J]>::try_from(&goal[..]))
+                else {
+                    return Err(format!("{}: not {J} joints", path.display()));
+                };
+                problems.push((start, goal));
+            }
         }
     }
     if problems.is_empty() {
@@ -191,8 +222,9 @@ pub fn run(args: &Args) -> Result<(), String> {
     }
     let empty = Scene::<1>::new();
     println!(
-        "Unguided prior, {} problems x {BATCH} trajectories ({} parameters, {} MAC per forward); \
+        "Unguided prior of the {}, {} problems x {BATCH} trajectories ({} parameters, {} MAC per forward); \
          roughness in radians (joint-space L2 between adjacent waypoints), time per problem on one core.\n",
+        robot.name,
         problems.len(),
         edmp_core::prior::PARAMETERS,
         edmp_core::prior::MACS
@@ -201,10 +233,8 @@ pub fn run(args: &Args) -> Result<(), String> {
         "| source | trajectories | AR | MRESG | RF2W | RL2W | outside hard limits % | self-colliding % | ms median / p95 |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
-    if let Some(data) = &args.data {
-        let all = read_npy(data)?;
-        let held = &all[all.len().saturating_sub(1200)..];
-        let q: Vec<Quality> = held.par_iter().map(|x| quality(x, &empty)).collect();
+    if !held.is_empty() {
+        let q: Vec<Quality> = held.par_iter().map(|x| quality(robot, x, &empty)).collect();
         println!("{}", row("training data (held out)", &q, None));
     }
     // The plot shows the problem with the longest way from start to goal.
@@ -214,7 +244,7 @@ pub fn run(args: &Args) -> Result<(), String> {
             d(*a).total_cmp(&d(*b))
         })
         .unwrap_or(0);
-    let mut plotted: Vec<(Sampler, [Path; BATCH])> = Vec::new();
+    let mut plotted: Vec<(Sampler, [PathOf<J>; BATCH])> = Vec::new();
     let conditions: &[bool] = if args.no_conditioning { &[true, false] } else { &[true] };
     let runs: Vec<(Sampler, bool)> = samplers
         .iter()
@@ -231,14 +261,15 @@ pub fn run(args: &Args) -> Result<(), String> {
                 .map_err(|e| e.to_string())?,
         );
         bar.set_message(label.clone());
-        let results: Vec<Result<(f64, [Path; BATCH]), String>> = problems
+        let results: Vec<Result<(f64, [PathOf<J>; BATCH]), String>> = problems
             .par_iter()
             .enumerate()
             .map(|(i, (start, goal))| {
                 let mut scratch = Box::new(Scratch::<4>::new());
-                let mut out = Box::new([[[0.0f32; JOINTS]; HORIZON]; BATCH]);
+                let mut out = Box::new([[[0.0f32; J]; HORIZON]; BATCH]);
                 let began = std::time::Instant::now();
-                sample_conditioned(
+                sample_with(
+                    network,
                     sampler,
                     condition,
                     start,
@@ -262,7 +293,7 @@ pub fn run(args: &Args) -> Result<(), String> {
             paths.push(out);
         }
         times.sort_by(f64::total_cmp);
-        let q: Vec<Quality> = paths.par_iter().flatten().map(|x| quality(x, &empty)).collect();
+        let q: Vec<Quality> = paths.par_iter().flatten().map(|x| quality(robot, x, &empty)).collect();
         println!(
             "{}",
             row(&label, &q, Some((percentile(&times, 0.5), percentile(&times, 0.95))))
@@ -275,7 +306,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         let first = plotted.first().map(|p| p.1);
         let last = plotted.last().map(|p| p.1);
         if let (Some(a), Some(b)) = (first, last) {
-            plot(path, &a, &b)?;
+            plot(robot, path, &a, &b)?;
             println!(
                 "\nwrote {} (joints top to bottom; blue: {}, orange: {}; grey: hard limits)",
                 path.display(),
@@ -287,16 +318,21 @@ pub fn run(args: &Args) -> Result<(), String> {
     Ok(())
 }
 
-/// Seven panels, one per joint: waypoint index across, the joint's hard range up.
-fn plot(path: &std::path::Path, a: &[Path; BATCH], b: &[Path; BATCH]) -> Result<(), String> {
+/// One panel per joint: waypoint index across, the joint's hard range up.
+fn plot<const J: usize>(
+    robot: &Robot<f32, J>,
+    path: &std::path::Path,
+    a: &[PathOf<J>; BATCH],
+    b: &[PathOf<J>; BATCH],
+) -> Result<(), String> {
     const W: usize = 900;
     const PANEL_H: usize = 110;
     const GAP: usize = 12;
-    let mut canvas = Canvas::new(W, JOINTS * (PANEL_H + GAP) + GAP);
+    let mut canvas = Canvas::new(W, J * (PANEL_H + GAP) + GAP);
     let (left, right) = (20.0, W as f32 - 20.0);
-    for j in 0..JOINTS {
+    for j in 0..J {
         let top = (GAP + j * (PANEL_H + GAP)) as f32;
-        let (lo, hi) = (PANDA.hard_lower[j], PANDA.hard_upper[j]);
+        let (lo, hi) = (robot.hard_lower[j], robot.hard_upper[j]);
         // Values outside the hard range are drawn on the panel's edge.
         let to_px = |w: usize, v: f32| {
             [
