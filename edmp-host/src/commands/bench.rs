@@ -235,7 +235,7 @@ fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record,
         ..crate::rrt::RrtConfig::default()
     };
     let began = std::time::Instant::now();
-    let planned = crate::rrt::plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+    let planned = crate::rrt::plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
         &edmp_core::robot::PANDA,
         &parsed.scene(),
         &parsed.start,

@@ -41,7 +41,7 @@ fn run_one(path: &Path, budget: Duration, seed: u64) -> Result<Outcome, String> 
         ..RrtConfig::default()
     };
     let began = std::time::Instant::now();
-    let planned = plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+    let planned = plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
         &edmp_core::robot::PANDA,
         &p.scene(),
         &p.start,

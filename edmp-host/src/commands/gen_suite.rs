@@ -102,7 +102,7 @@ pub(crate) fn solvable(family: Family, seed: u64, budget: Duration) -> Option<Pr
         budget,
         ..RrtConfig::default()
     };
-    plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+    plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
         &edmp_core::robot::PANDA,
         &p.scene,
         &p.start,
@@ -226,7 +226,7 @@ mod tests {
                     };
                     let mut last = Err(String::new());
                     for s in seed..seed + 4 {
-                        last = plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+                        last = plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
                             &edmp_core::robot::PANDA,
                             &p.scene(),
                             &p.start,
@@ -309,7 +309,7 @@ mod tests {
                         budget: Duration::from_secs(60),
                         ..RrtConfig::default()
                     };
-                    plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+                    plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
                         &edmp_core::robot::PANDA,
                         &p.scene(),
                         &p.start,

@@ -37,7 +37,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         budget: Duration::from_millis(args.budget_ms),
         ..RrtConfig::default()
     };
-    let planned = plan::<50, 7, { edmp_core::scene::MAX_OBSTACLES }>(
+    let planned = plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
         &edmp_core::robot::PANDA,
         &problem.scene(),
         &problem.start,
