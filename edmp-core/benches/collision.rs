@@ -88,7 +88,7 @@ fn bench(c: &mut Criterion) {
         };
         let total: f32 = batch
             .iter()
-            .map(|t| trajectory_cost(&scene, t, &config, None).unwrap())
+            .map(|t| trajectory_cost(&PANDA, &scene, t, &config, None).unwrap())
             .sum();
         assert!(total > 0.0, "the bench scene must make the {name} cost work");
         group.bench_function(format!("{name} cost+gradient, 12x50 waypoints, 20 obstacles"), |b| {
@@ -96,7 +96,7 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 let mut sum = 0.0;
                 for t in black_box(&batch) {
-                    sum += trajectory_cost(&scene, t, &config, Some(&mut grad)).unwrap();
+                    sum += trajectory_cost(&PANDA, &scene, t, &config, Some(&mut grad)).unwrap();
                 }
                 sum
             })
@@ -128,6 +128,7 @@ fn bench(c: &mut Criterion) {
         for _ in 0..count(t) {
             guide_step_on(
                 &Serial,
+                &PANDA,
                 scene,
                 &mut rows,
                 &mut grads,

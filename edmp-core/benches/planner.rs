@@ -56,6 +56,8 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 plan(
                     &Request {
+                        robot: &edmp_core::robot::PANDA,
+                        network: edmp_core::prior::PANDA,
                         scene: &scene,
                         start: &start,
                         goal: &goal,

@@ -5,6 +5,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::planner::search::{SearchConfig, SearchSpace, search};
 use edmp_core::rng::Rng;
+use edmp_core::robot::PANDA;
 use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::{Obstacle, Scene};
 
@@ -30,9 +31,17 @@ fn bench(c: &mut Criterion) {
     let config = SearchConfig::DEFAULT;
     let mut space = Box::new(SearchSpace::<2048>::new());
     for seed in 1..=4 {
-        let o = search(&start, &goal, &config, &mut space, &mut Rng::new(seed), &mut edge_free)
-            .unwrap()
-            .unwrap();
+        let o = search(
+            &PANDA,
+            &start,
+            &goal,
+            &config,
+            &mut space,
+            &mut Rng::new(seed),
+            &mut edge_free,
+        )
+        .unwrap()
+        .unwrap();
         println!(
             "seed {seed}: {} iterations, {} nodes, {} corners, {} oracle calls (bound {})",
             o.iterations,
@@ -46,7 +55,17 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     for seed in [1u64, 2] {
         group.bench_function(format!("wall, exact checker, SearchSpace<2048>, seed {seed}"), |b| {
-            b.iter(|| search(&start, &goal, &config, &mut space, &mut Rng::new(seed), &mut edge_free))
+            b.iter(|| {
+                search(
+                    &PANDA,
+                    &start,
+                    &goal,
+                    &config,
+                    &mut space,
+                    &mut Rng::new(seed),
+                    &mut edge_free,
+                )
+            })
         });
     }
     // The search's own cost (nearest-node scans, shortcuts, resampling) without the checker:
@@ -57,7 +76,7 @@ fn bench(c: &mut Criterion) {
         [1.0, -1.0, 0.0, -1.5, 0.0, 1.5, 0.0],
     );
     group.bench_function("joint-space wall with a gap, analytic oracle, seed 1", |b| {
-        b.iter(|| search(&s, &g, &config, &mut space, &mut Rng::new(1), &mut wall))
+        b.iter(|| search(&PANDA, &s, &g, &config, &mut space, &mut Rng::new(1), &mut wall))
     });
     group.finish();
 }

@@ -11,6 +11,7 @@ use edmp_core::guidance::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{Observer, Phase, Plan, PlanConfig, Request, Workspace, plan_observed};
 use edmp_core::prior::Scratch;
 use edmp_core::rng::Rng;
+use edmp_core::robot::PANDA;
 use std::time::Instant;
 
 /// Rows of the batch: EDMP's 12 guides, one trajectory each.
@@ -81,6 +82,8 @@ fn plan_with<E: Executor, const C: usize>(
     let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
     let mut work = Box::new(Workspace::<ROWS, HOST_SEARCH_NODES>::new());
     let req = Request {
+        robot: &PANDA,
+        network: edmp_core::prior::PANDA,
         scene: &problem.scene(),
         start: &problem.start,
         goal: &goal,

@@ -4,6 +4,7 @@
 //! the bits of a fresh evaluation; the exact checker must answer or refuse, never panic.
 #![no_main]
 
+use edmp_core::robot::PANDA;
 use edmp_core::Error;
 use edmp_core::collision::checker::{CheckConfig, check_state, check_trajectory};
 use edmp_core::cost::{CostConfig, CostKind, CostMemo, trajectory_cost, trajectory_cost_memo};
@@ -82,7 +83,7 @@ fuzz_target!(|data: &[u8]| {
         && inflation.clearance >= 0.0
         && inflation.expansion >= 0.0;
     let mut gradient = [[0.0f32; 7]; H];
-    match trajectory_cost(&scene, &trajectory, &config, Some(&mut gradient)) {
+    match trajectory_cost(&PANDA, &scene, &trajectory, &config, Some(&mut gradient)) {
         Ok(cost) => {
             assert!(joints_finite && params_ok);
             assert!(cost.is_finite() && cost >= 0.0, "cost {cost}");
@@ -96,7 +97,7 @@ fuzz_target!(|data: &[u8]| {
 
     // The memo: evaluate, move one waypoint by the input's amount, report it, evaluate again.
     let mut memo = CostMemo::NONE;
-    let first = trajectory_cost_memo(&scene, &trajectory, &config, Some(&mut gradient), Some(&mut memo));
+    let first = trajectory_cost_memo(&PANDA, &scene, &trajectory, &config, Some(&mut gradient), Some(&mut memo));
     let (w, j, by) = (usize::from(r.byte()) % H, usize::from(r.byte()) % 7, r.f32());
     let mut moved = trajectory;
     moved[w][j] += by;
@@ -105,8 +106,8 @@ fuzz_target!(|data: &[u8]| {
     }
     let mut fresh = [[0.0f32; 7]; H];
     let mut memoed = [[0.0f32; 7]; H];
-    let want = trajectory_cost(&scene, &moved, &config, Some(&mut fresh));
-    let got = trajectory_cost_memo(&scene, &moved, &config, Some(&mut memoed), Some(&mut memo));
+    let want = trajectory_cost(&PANDA, &scene, &moved, &config, Some(&mut fresh));
+    let got = trajectory_cost_memo(&PANDA, &scene, &moved, &config, Some(&mut memoed), Some(&mut memo));
     if first.is_ok() {
         let bits = |x: Result<f32, Error>| x.map(f32::to_bits);
         assert_eq!(bits(got), bits(want), "memo after moving waypoint {w}");

@@ -5,6 +5,7 @@
 //! stop (`PlanConfig::refine_stop`) is fuzzed too, zero settings (typed errors) included.
 #![no_main]
 
+use edmp_core::robot::PANDA;
 use edmp_core::collision::checker::CheckConfig;
 use edmp_core::cost::boxes::{BoxFrame, CylinderBox};
 use edmp_core::planner::GlobalConfig;
@@ -156,7 +157,7 @@ fuzz_target!(|data: &[u8]| {
         g.smooth = if extra & 4 != 0 { 0.1 } else { 0.0 };
     }
     let guides = &table[..count];
-    if let Ok(p) = plan(&Request { scene: &scene, start: &start, goal: &goal, guides: guides, config: &config }, &mut Rng::new(seed), &mut scratch, &mut work) {
+    if let Ok(p) = plan(&Request { robot: &PANDA, network: edmp_core::prior::PANDA, scene: &scene, start: &start, goal: &goal, guides: guides, config: &config }, &mut Rng::new(seed), &mut scratch, &mut work) {
         assert!(steps >= 1);
         for (path, verdict) in p.paths.iter().zip(&p.verdicts) {
             assert!(path.iter().flatten().all(|v| v.is_finite()));

@@ -10,6 +10,7 @@
 mod common;
 
 use common::{Reader, finite, scene};
+use edmp_core::robot::PANDA;
 use edmp_core::Error;
 use edmp_core::collision::checker::{CheckConfig, check_segment};
 use edmp_core::robot::kinematics::Joints;
@@ -63,7 +64,7 @@ fuzz_target!(|data: &[u8]| {
             Ok(analytic_free(&boxes, a, b))
         }
     };
-    let result = search(&start, &goal, &config, &mut space, &mut rng, &mut oracle);
+    let result = search(&PANDA, &start, &goal, &config, &mut space, &mut rng, &mut oracle);
     let within_limits = |q: &[f32; 7]| edmp_core::robot::PANDA.within_soft_limits(q, 1e-5);
     let bound = config.max_oracle_calls(CAP);
     assert!(u64::from(calls) <= bound, "{calls} oracle calls, bound {bound}");

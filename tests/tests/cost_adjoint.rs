@@ -118,7 +118,7 @@ proptest! {
 
     #[test]
     fn cost_matches_the_f64_reference(c in case()) {
-        let cost = trajectory_cost(&c.scene, &c.trajectory, &c.config, None).unwrap();
+        let cost = trajectory_cost(&PANDA, &c.scene, &c.trajectory, &c.config, None).unwrap();
         let q64: Vec<[f64; JOINTS]> = c.trajectory.iter().map(|q| q.map(f64::from)).collect();
         let reference = reference::cost(&c.scene, &q64, &c.config).value;
         // f32 coordinates of ~1 m carry ~1e-7 m of error into overlaps of a few cm.
@@ -128,7 +128,7 @@ proptest! {
     #[test]
     fn adjoint_matches_finite_differences_away_from_kinks(c in case()) {
         let mut grad = [[0.0f32; JOINTS]; H];
-        trajectory_cost(&c.scene, &c.trajectory, &c.config, Some(&mut grad)).unwrap();
+        trajectory_cost(&PANDA, &c.scene, &c.trajectory, &c.config, Some(&mut grad)).unwrap();
         let q64: Vec<[f64; JOINTS]> = c.trajectory.iter().map(|q| q.map(f64::from)).collect();
         let here = reference::cost(&c.scene, &q64, &c.config);
         // f32 resolves ~1e-7 m at 1 m: a choice decided by less than 1e-5 m may go the other
@@ -183,7 +183,7 @@ proptest! {
             scene.hold(*held);
         }
         let mut grad = [[1.0f32; JOINTS]; H];
-        let cost = trajectory_cost(&scene, &c.trajectory, &c.config, Some(&mut grad)).unwrap();
+        let cost = trajectory_cost(&PANDA, &scene, &c.trajectory, &c.config, Some(&mut grad)).unwrap();
         prop_assert_eq!(cost, 0.0);
         prop_assert!(grad.iter().flatten().all(|&g| g == 0.0));
     }
@@ -227,7 +227,7 @@ fn the_gradient_at_a_non_default_opening_matches_finite_differences() {
                 frame: BoxFrame::Obstacle,
             };
             let mut grad = [[0.0f32; JOINTS]; H];
-            let cost = trajectory_cost(&scene, &trajectory, &config, Some(&mut grad)).unwrap();
+            let cost = trajectory_cost(&PANDA, &scene, &trajectory, &config, Some(&mut grad)).unwrap();
             let q64: Vec<[f64; JOINTS]> = trajectory.iter().map(|q| q.map(f64::from)).collect();
             let here = reference::cost(&scene, &q64, &config);
             assert!(
@@ -295,7 +295,7 @@ fn original_cylinder_boxing_under_covers() {
         cylinder,
         frame: BoxFrame::World,
     };
-    let enclosing = trajectory_cost(&scene, &[q; 3], &cfg(CylinderBox::Enclosing), None).unwrap();
-    let original = trajectory_cost(&scene, &[q; 3], &cfg(CylinderBox::OriginalEdmp), None).unwrap();
+    let enclosing = trajectory_cost(&PANDA, &scene, &[q; 3], &cfg(CylinderBox::Enclosing), None).unwrap();
+    let original = trajectory_cost(&PANDA, &scene, &[q; 3], &cfg(CylinderBox::OriginalEdmp), None).unwrap();
     assert!(enclosing > original && original > 0.0, "{enclosing} {original}");
 }

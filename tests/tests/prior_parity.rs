@@ -5,7 +5,7 @@
 //! The fixture holds, per case, the fake-quantized model's ε (int8 weights × scale, float
 //! activations: the same arithmetic as `edmp-core`, in another order) and the float model's.
 
-use edmp_core::path::{HORIZON, PathOf};
+use edmp_core::path::{HORIZON, Path};
 use edmp_core::prior::{Network, Scratch, TimeEmbedding, predict_noise};
 use serde::Deserialize;
 
@@ -26,7 +26,7 @@ struct Fixture {
     int8_vs_float_max_relative: f64,
 }
 
-fn worst<const J: usize>(got: &PathOf<J>, want: &[Vec<f64>]) -> f64 {
+fn worst<const J: usize>(got: &Path<J>, want: &[Vec<f64>]) -> f64 {
     assert!(want.iter().all(|w| w.len() == J), "{J} joints per waypoint");
     let scale = want.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     let diff = got
@@ -38,13 +38,13 @@ fn worst<const J: usize>(got: &PathOf<J>, want: &[Vec<f64>]) -> f64 {
 }
 
 /// Runs every case of the fixture at `path` through `predict` (one trajectory at step `t`).
-fn parity<const J: usize>(path: &str, predict: impl Fn(&PathOf<J>, u16) -> PathOf<J>) {
+fn parity<const J: usize>(path: &str, predict: impl Fn(&Path<J>, u16) -> Path<J>) {
     let fixture: Fixture = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     assert!(fixture.cases.len() >= 8);
     let (mut worst_fq, mut worst_float) = (0.0f64, 0.0f64);
     for case in &fixture.cases {
         assert_eq!(case.x.len(), HORIZON);
-        let x: PathOf<J> = core::array::from_fn(|w| case.x[w].clone().try_into().expect("J joints"));
+        let x: Path<J> = core::array::from_fn(|w| case.x[w].clone().try_into().expect("J joints"));
         let eps = predict(&x, case.t);
         let (fq, float) = (worst(&eps, &case.eps_fake_quant), worst(&eps, &case.eps_float));
         assert!(

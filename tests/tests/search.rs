@@ -6,6 +6,7 @@ use edmp_core::collision::checker::{CheckConfig, check_state, check_trajectory};
 use edmp_core::path::HORIZON;
 use edmp_core::planner::search::{SearchConfig, SearchSpace, search};
 use edmp_core::rng::Rng;
+use edmp_core::robot::PANDA;
 use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::{Obstacle, Scene};
 
@@ -45,9 +46,17 @@ fn search_finds_a_checked_free_path_around_a_wall() {
             calls += 1;
             Ok(check_trajectory(&edmp_core::robot::PANDA, &scene, &[*a, *b], &cfg, true)?.is_free())
         };
-        let found = search(&start, &goal, &config, &mut space, &mut Rng::new(seed), &mut edge_free)
-            .unwrap()
-            .expect("a path around the wall");
+        let found = search(
+            &PANDA,
+            &start,
+            &goal,
+            &config,
+            &mut space,
+            &mut Rng::new(seed),
+            &mut edge_free,
+        )
+        .unwrap()
+        .expect("a path around the wall");
         println!(
             "seed {seed}: {} iterations, {} nodes, {} corners, even {}, {} oracle calls",
             found.iterations, found.nodes, found.corners, found.even, found.oracle_calls
@@ -63,6 +72,7 @@ fn search_finds_a_checked_free_path_around_a_wall() {
     let found = first.unwrap();
     // Deterministic: the same seed gives the same bits.
     let again = search(
+        &PANDA,
         &start,
         &goal,
         &config,

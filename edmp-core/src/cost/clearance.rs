@@ -32,7 +32,7 @@ use crate::collision::convex::{Convex, Hull, Solid};
 use crate::collision::gjk::{closest, gap_along};
 use crate::error::Error;
 use crate::robot::kinematics::{Cotangent, Joints, Kinematics, forward_with};
-use crate::robot::{BODIES, FRAMES, HAND_FRAME, JOINTS, PANDA};
+use crate::robot::{MAX_BODIES, MAX_FRAMES, Robot};
 use crate::scene::Scene;
 use nalgebra::Vector3;
 
@@ -42,11 +42,12 @@ use nalgebra::Vector3;
 /// through a thin board between waypoints); with `gradient`, its gradient with respect to every
 /// waypoint (zero at the ends). Non-finite joints and a negative or non-finite clearance are
 /// typed errors; so is an overflowing result.
-pub fn trajectory_cost<const H: usize, const N: usize>(
+pub fn trajectory_cost<const H: usize, const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    trajectory: &[Joints<f32>; H],
+    trajectory: &[Joints<f32, J>; H],
     clearance: f32,
-    gradient: Option<&mut [Joints<f32>; H]>,
+    gradient: Option<&mut [Joints<f32, J>; H]>,
 ) -> Result<f32, Error> {
     if !(clearance.is_finite() && clearance >= 0.0) {
         return Err(Error::BadParameter);
@@ -67,20 +68,21 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
     for (r, o) in reach.iter_mut().zip(obstacles) {
         *r = o.bounding_radius() + clearance;
     }
-    let mut radius = [0.0f32; BODIES];
-    for (r, body) in radius.iter_mut().zip(PANDA.bodies.iter()) {
+    let mut radius = [0.0f32; MAX_BODIES];
+    for (r, body) in radius.iter_mut().zip(robot.bodies.iter()) {
         *r = crate::float::sqrt(body.half_extents.norm_squared());
     }
 
     let mut gradient = gradient;
     if let Some(g) = gradient.as_deref_mut() {
-        g.fill([0.0; JOINTS]);
+        g.fill([0.0; J]);
     }
     let mut total = 0.0f32;
     // Waypoint w − 1 and w in flight, each with the cotangent its segments gather.
-    let mut before: Option<(Kinematics<f32, JOINTS>, Cotangent<f32>, bool)> = None;
+    let mut before: Option<(Kinematics<f32, J>, Cotangent<f32>, bool)> = None;
+    let hand = robot.hand_frame.min(MAX_FRAMES - 1);
     for (w, q) in trajectory.iter().enumerate() {
-        let k = forward_with(&PANDA, q, scene.gripper())?;
+        let k = forward_with(robot, q, robot.finger_opening(scene.gripper()))?;
         let mut current = (k, Cotangent::new(), false);
         if let Some((kb, cot_b, touched_b)) = before.as_mut() {
             let (kc, cot_c, touched_c) = (&current.0, &mut current.1, &mut current.2);
@@ -124,10 +126,10 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
                     }
                 }
             };
-            for b in (0..BODIES).filter(|&b| moves(&PANDA, b)) {
-                let Some(body) = PANDA.bodies.get(b) else { continue };
-                let frame = body.frame.min(FRAMES - 1);
-                let points = PANDA.hull(b);
+            for b in (0..robot.bodies.len().min(MAX_BODIES)).filter(|&b| moves(robot, b)) {
+                let Some(body) = robot.bodies.get(b) else { continue };
+                let frame = body.frame.min(MAX_FRAMES - 1);
+                let points = robot.hull(b);
                 let (hb, hc) = (
                     Hull {
                         pose: &kb.frames[frame],
@@ -145,16 +147,10 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
             }
             if let Some(h) = scene.held() {
                 let (pb, pc) = (
-                    Solid::attached(h, &kb.frames[HAND_FRAME]),
-                    Solid::attached(h, &kc.frames[HAND_FRAME]),
+                    Solid::attached(h, &kb.frames[hand]),
+                    Solid::attached(h, &kc.frames[hand]),
                 );
-                segment(
-                    [&pb, &pc],
-                    None,
-                    HAND_FRAME,
-                    [&pb.center, &pc.center],
-                    pb.bounding_radius(),
-                );
+                segment([&pb, &pc], None, hand, [&pb.center, &pc.center], pb.bounding_radius());
             }
         }
         if let Some((kb, cot_b, touched_b)) = before.take() {
@@ -173,10 +169,10 @@ pub fn trajectory_cost<const H: usize, const N: usize>(
 }
 
 /// Waypoint `w`'s joint gradient from its cotangent, zero at the ends and where nothing pulled.
-fn write_gradient<const H: usize>(
-    gradient: Option<&mut [Joints<f32>; H]>,
+fn write_gradient<const H: usize, const J: usize>(
+    gradient: Option<&mut [Joints<f32, J>; H]>,
     w: usize,
-    k: &Kinematics<f32, JOINTS>,
+    k: &Kinematics<f32, J>,
     cot: &Cotangent<f32>,
     touched: bool,
 ) -> Result<(), Error> {
@@ -250,6 +246,7 @@ fn signed_gap<A: Convex>(a: &A, b: &Solid, towards: &Vector3<f32>) -> (f32, Vect
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::robot::{BODIES, JOINTS, PANDA};
     use crate::scene::Obstacle;
 
     const H: usize = 6;
@@ -272,7 +269,7 @@ mod tests {
     #[test]
     fn far_from_everything_the_cost_and_gradient_are_zero() {
         let mut g = [[1.0; JOINTS]; H];
-        let c = trajectory_cost(&Scene::<4>::new(), &reach(1.0), 0.05, Some(&mut g)).unwrap();
+        let c = trajectory_cost(&PANDA, &Scene::<4>::new(), &reach(1.0), 0.05, Some(&mut g)).unwrap();
         assert_eq!(c, 0.0);
         assert!(g.iter().flatten().all(|&x| x == 0.0));
     }
@@ -283,7 +280,7 @@ mod tests {
         let x = reach(0.55);
         let clearance = 0.05;
         let mut g = [[0.0; JOINTS]; H];
-        let c = trajectory_cost(&scene, &x, clearance, Some(&mut g)).unwrap();
+        let c = trajectory_cost(&PANDA, &scene, &x, clearance, Some(&mut g)).unwrap();
         assert!(c > 0.0, "the arm comes within the clearance of the wall");
         assert_eq!(g[0], [0.0; JOINTS]);
         assert_eq!(g[H - 1], [0.0; JOINTS]);
@@ -294,8 +291,8 @@ mod tests {
                 let (mut up, mut down) = (x, x);
                 up[w][j] += h;
                 down[w][j] -= h;
-                let fd = (trajectory_cost(&scene, &up, clearance, None).unwrap()
-                    - trajectory_cost(&scene, &down, clearance, None).unwrap())
+                let fd = (trajectory_cost(&PANDA, &scene, &up, clearance, None).unwrap()
+                    - trajectory_cost(&PANDA, &scene, &down, clearance, None).unwrap())
                     / (2.0 * h);
                 let scale = fd.abs().max(g[w][j].abs()).max(1e-3);
                 assert!(
@@ -315,7 +312,7 @@ mod tests {
                 *v -= 0.01 * gv / norm;
             }
         }
-        assert!(trajectory_cost(&scene, &next, clearance, None).unwrap() < c);
+        assert!(trajectory_cost(&PANDA, &scene, &next, clearance, None).unwrap() < c);
     }
 
     /// Many arms near many obstacles (a fixed stream of random cases): wherever the cost pulls,
@@ -346,7 +343,7 @@ mod tests {
             };
             scene.push(o.unwrap()).unwrap();
             let mut g = [[0.0; JOINTS]; H];
-            let c = trajectory_cost(&scene, &x, 0.03, Some(&mut g)).unwrap();
+            let c = trajectory_cost(&PANDA, &scene, &x, 0.03, Some(&mut g)).unwrap();
             assert!(c.is_finite() && c >= 0.0);
             let norm = crate::float::sqrt(g.iter().flatten().map(|v| v * v).sum::<f32>());
             if norm == 0.0 {
@@ -359,7 +356,7 @@ mod tests {
                     *v -= 1e-3 * gv / norm;
                 }
             }
-            descended += usize::from(trajectory_cost(&scene, &next, 0.03, None).unwrap() < c);
+            descended += usize::from(trajectory_cost(&PANDA, &scene, &next, 0.03, None).unwrap() < c);
         }
         assert!(pulled >= 50, "{pulled} cases pull");
         assert!(descended * 100 >= pulled * 95, "{descended} of {pulled} descend");
@@ -374,11 +371,11 @@ mod tests {
             [-0.7, 0.3, 0.0, -2.0, 0.0, 2.2, 0.7],
             [0.7, 0.3, 0.0, -2.0, 0.0, 2.2, 0.7],
         );
-        let cost = |x: &[Joints<f32>; 3]| trajectory_cost(&scene, x, 0.01, None).unwrap();
+        let cost = |x: &[Joints<f32>; 3]| trajectory_cost(&PANDA, &scene, x, 0.01, None).unwrap();
         assert_eq!(cost(&[a; 3]), 0.0);
         assert_eq!(cost(&[b; 3]), 0.0);
         let mut g = [[0.0; JOINTS]; 3];
-        assert!(trajectory_cost(&scene, &[a, a, b], 0.01, Some(&mut g)).unwrap() > 0.0);
+        assert!(trajectory_cost(&PANDA, &scene, &[a, a, b], 0.01, Some(&mut g)).unwrap() > 0.0);
         assert!(
             g[1].iter().any(|&v| v != 0.0),
             "the interior waypoint is pulled back from the board"
@@ -397,11 +394,17 @@ mod tests {
     #[test]
     fn bad_input_is_a_typed_error() {
         let mut x = reach(0.5);
-        assert_eq!(trajectory_cost(&wall(), &x, -0.1, None), Err(Error::BadParameter));
-        assert_eq!(trajectory_cost(&wall(), &x, f32::NAN, None), Err(Error::BadParameter));
+        assert_eq!(
+            trajectory_cost(&PANDA, &wall(), &x, -0.1, None),
+            Err(Error::BadParameter)
+        );
+        assert_eq!(
+            trajectory_cost(&PANDA, &wall(), &x, f32::NAN, None),
+            Err(Error::BadParameter)
+        );
         x[2][3] = f32::INFINITY;
         assert_eq!(
-            trajectory_cost(&wall(), &x, 0.05, None),
+            trajectory_cost(&PANDA, &wall(), &x, 0.05, None),
             Err(Error::NonFiniteJoint { joint: 3 })
         );
     }

@@ -24,7 +24,7 @@ pub mod cover;
 use crate::cost::boxes::{Aabb, BoxFrame, CylinderBox, Inflation, box_dims, inflated_dims, obstacle_aabb};
 use crate::error::Error;
 use crate::robot::kinematics::{CORNERS, Cotangent, Joints, Kinematics, Pose, box_corner, forward_into};
-use crate::robot::{BODIES, HAND_FRAME, JOINTS, MAX_BODIES, MAX_FRAMES, PANDA};
+use crate::robot::{MAX_BODIES, MAX_FRAMES, Robot};
 use crate::scene::{Obstacle, Scene};
 use nalgebra::{Matrix3, Vector3};
 
@@ -55,9 +55,13 @@ pub struct CostConfig {
     pub frame: BoxFrame,
 }
 
-/// Robot box slots per waypoint: every collision body, then the held object.
-const SLOTS: usize = BODIES + 1;
-const HELD: usize = BODIES;
+/// Robot box slots per waypoint: every collision body of the largest arm compiled in, then the
+/// held object (slot `robot.bodies.len()`: right after the arm's own bodies).
+const SLOTS: usize = MAX_BODIES + 1;
+
+/// One bit per slot.
+type SlotMask = u32;
+const _: () = assert!(SLOTS <= SlotMask::BITS as usize);
 
 /// One obstacle as the costs see it: a frame and the inflated box in it, and a ball holding
 /// that box (broad phase).
@@ -225,8 +229,8 @@ fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector
 /// boxes' corners have collected so far. Filled in place ([`Waypoint::place`]): the struct is a
 /// few kilobytes and the costs' inner loop must not copy it.
 #[derive(Clone, Copy, Debug)]
-struct Waypoint {
-    k: Kinematics<f32, JOINTS>,
+struct Waypoint<const J: usize> {
+    k: Kinematics<f32, J>,
     boxes: [RobotBox; SLOTS],
     /// Per box, a world AABB holding its AABB in any frame, and their union (broad phase).
     balls: SlotBoxes,
@@ -240,52 +244,56 @@ struct Waypoint {
 #[derive(Clone, Copy, Debug)]
 struct Pulls {
     corners: [[Vector3<f32>; CORNERS]; SLOTS],
-    touched: u16,
+    touched: SlotMask,
 }
-
-const _: () = assert!(SLOTS <= 16);
 
 const NO_BOX: Aabb = Aabb {
     min: Vector3::new(0.0, 0.0, 0.0),
     max: Vector3::new(0.0, 0.0, 0.0),
 };
 
-impl Waypoint {
-    const EMPTY: Self = Self {
-        k: Kinematics {
-            robot: &PANDA,
-            frames: [IDLE.pose; MAX_FRAMES],
-            boxes: [IDLE.pose; MAX_BODIES],
-        },
-        boxes: [IDLE; SLOTS],
-        balls: SlotBoxes::EMPTY,
-        hull: NO_BOX,
-        pulls: Pulls {
-            corners: [[Vector3::new(0.0, 0.0, 0.0); CORNERS]; SLOTS],
-            touched: 0,
-        },
-    };
+impl<const J: usize> Waypoint<J> {
+    /// Nothing placed yet, for `robot`.
+    const fn empty(robot: &'static Robot<f32, J>) -> Self {
+        Self {
+            k: Kinematics {
+                robot,
+                frames: [IDLE.pose; MAX_FRAMES],
+                boxes: [IDLE.pose; MAX_BODIES],
+            },
+            boxes: [IDLE; SLOTS],
+            balls: SlotBoxes::EMPTY,
+            hull: NO_BOX,
+            pulls: Pulls {
+                corners: [[Vector3::new(0.0, 0.0, 0.0); CORNERS]; SLOTS],
+                touched: 0,
+            },
+        }
+    }
 
     /// Places the boxes of the kinematics in `self.k` (and the held object's) and clears the
     /// gradient.
     /// `radii` holds every slot's `|half|` (the held object's last).
     fn place(&mut self, held: Option<(&Pose<f32>, Vector3<f32>)>, radii: &[f32; SLOTS]) {
         let k = &self.k;
+        let robot = k.robot;
         let boxes = &mut self.boxes;
         *boxes = [IDLE; SLOTS];
-        for (b, (slot, &radius)) in boxes.iter_mut().zip(radii).enumerate().take(BODIES) {
+        for (((slot, &radius), body), pose) in boxes.iter_mut().zip(radii).zip(robot.bodies).zip(&k.boxes) {
             // Bodies on the fixed root (link0) never move and are not checked against obstacles.
-            if PANDA.bodies[b].frame != 0 {
-                *slot = RobotBox::new(k.boxes[b], PANDA.bodies[b].half_extents, radius);
+            if body.frame != 0 {
+                *slot = RobotBox::new(*pose, body.half_extents, radius);
             }
         }
-        if let Some((local, half)) = held {
-            let hand = &k.frames[HAND_FRAME];
+        let held_slot = robot.bodies.len();
+        if let (Some((local, half)), Some(hand)) = (held, k.frames.get(robot.hand_frame)) {
             let pose = Pose {
                 rotation: hand.rotation * local.rotation,
                 translation: hand.transform_point(&local.translation),
             };
-            boxes[HELD] = RobotBox::new(pose, half, radii[HELD]);
+            if let (Some(slot), Some(&radius)) = (boxes.get_mut(held_slot), radii.get(held_slot)) {
+                *slot = RobotBox::new(pose, half, radius);
+            }
         }
         let mut hull: Option<Aabb> = None;
         self.balls = SlotBoxes::EMPTY;
@@ -379,23 +387,25 @@ impl CostMemo {
 ///
 /// One streaming pass: each waypoint's FK runs once, and its gradient is finished as soon as
 /// the last segment that touches it has been costed, so memory does not grow with `H`.
-pub fn trajectory_cost<const H: usize, const N: usize>(
+pub fn trajectory_cost<const H: usize, const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    trajectory: &[Joints<f32>; H],
+    trajectory: &[Joints<f32, J>; H],
     config: &CostConfig,
-    gradient: Option<&mut [Joints<f32>; H]>,
+    gradient: Option<&mut [Joints<f32, J>; H]>,
 ) -> Result<f32, Error> {
-    trajectory_cost_memo(scene, trajectory, config, gradient, None)
+    trajectory_cost_memo(robot, scene, trajectory, config, gradient, None)
 }
 
 /// [`trajectory_cost`] that skips what `memo` shows cannot reach an obstacle box, and updates
 /// `memo` for the next evaluation of the same row in the same scene. The same bits as
 /// [`trajectory_cost`]. Trajectories of more than 64 waypoints are evaluated in full.
-pub fn trajectory_cost_memo<const H: usize, const N: usize>(
+pub fn trajectory_cost_memo<const H: usize, const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    trajectory: &[Joints<f32>; H],
+    trajectory: &[Joints<f32, J>; H],
     config: &CostConfig,
-    gradient: Option<&mut [Joints<f32>; H]>,
+    gradient: Option<&mut [Joints<f32, J>; H]>,
     memo: Option<&mut CostMemo>,
 ) -> Result<f32, Error> {
     let Inflation { clearance, expansion } = config.inflation;
@@ -403,7 +413,7 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
         return Err(Error::BadParameter);
     }
     if config.kind == CostKind::Clearance {
-        return crate::cost::clearance::trajectory_cost(scene, trajectory, clearance, gradient);
+        return crate::cost::clearance::trajectory_cost(robot, scene, trajectory, clearance, gradient);
     }
     // Refuse bad input before any work, so the error names it whatever comes later.
     for q in trajectory {
@@ -434,10 +444,12 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
         .map(|h| (held_local_pose(h), box_dims(&h.shape, config.cylinder) * 0.5));
     let held = held.as_ref().map(|(pose, half)| (pose, *half));
     let mut radii = [0.0f32; SLOTS];
-    for (r, body) in radii.iter_mut().zip(PANDA.bodies.iter()) {
+    for (r, body) in radii.iter_mut().zip(robot.bodies.iter()) {
         *r = radius_of(&body.half_extents);
     }
-    radii[HELD] = held.map_or(0.0, |(_, half)| radius_of(&half));
+    if let Some(r) = radii.get_mut(robot.bodies.len()) {
+        *r = held.map_or(0.0, |(_, half)| radius_of(&half));
+    }
 
     // What the last evaluation of this row left: only for the same configuration.
     let memo = memo.filter(|_| H <= 64);
@@ -461,7 +473,7 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
     let mut total = 0.0f32;
     // Two waypoints in flight, swapped by reference: `before` is waypoint w − 1. A waypoint no
     // unit needs is not placed (its flag is false) and its gradient is zero.
-    let mut pair = [Waypoint::EMPTY; 2];
+    let mut pair = [Waypoint::empty(robot); 2];
     let [before, current] = &mut pair;
     let (mut before, mut current) = (before, current);
     let mut before_placed = false;
@@ -469,7 +481,7 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
         let placed = needed(w);
         if placed {
             // The scene's finger opening places the finger boxes; for the adjoint it is a constant.
-            forward_into(q, scene.gripper(), &mut current.k)?;
+            forward_into(q, robot.finger_opening(scene.gripper()), &mut current.k)?;
             current.place(held, &radii);
         }
         // The unit that ends at this waypoint: sv the segment into it, iv the waypoint itself.
@@ -514,11 +526,11 @@ pub fn trajectory_cost_memo<const H: usize, const N: usize>(
 }
 
 /// Writes waypoint `w`'s joint gradient once its corners' gradients are final.
-fn finish<const H: usize>(
-    done: &Waypoint,
+fn finish<const H: usize, const J: usize>(
+    done: &Waypoint<J>,
     placed: bool,
     w: usize,
-    gradient: Option<&mut [Joints<f32>; H]>,
+    gradient: Option<&mut [Joints<f32, J>; H]>,
 ) -> Result<(), Error> {
     let Some(slot) = gradient.and_then(|g| g.get_mut(w)) else {
         return Ok(());
@@ -530,7 +542,7 @@ fn finish<const H: usize>(
             other => other,
         })?
     } else {
-        [0.0; JOINTS]
+        [0.0; J]
     };
     Ok(())
 }
@@ -541,9 +553,9 @@ fn overlaps(a: &Aabb, b: &Aabb) -> bool {
     hi.x > lo.x && hi.y > lo.y && hi.z > lo.z
 }
 
-/// Lanes of [`SlotBoxes`]: every slot, rounded up to two AVX registers.
-const LANES: usize = 16;
-const _: () = assert!(SLOTS <= LANES && LANES <= 16);
+/// Lanes of [`SlotBoxes`]: every slot, rounded up to a multiple of 8 (whole AVX registers).
+const LANES: usize = SLOTS.div_ceil(8) * 8;
+const _: () = assert!(SLOTS <= LANES && LANES <= SlotMask::BITS as usize);
 
 /// One box per robot slot, as structure of arrays (a lane per slot, an array per bound and
 /// axis), so that the broad phase tests every slot against one obstacle in a few vector
@@ -553,7 +565,7 @@ struct SlotBoxes {
     min: [[f32; LANES]; 3],
     max: [[f32; LANES]; 3],
     /// Bit `s` set where lane `s` holds a box of positive volume.
-    solid: u16,
+    solid: SlotMask,
 }
 
 impl SlotBoxes {
@@ -579,7 +591,7 @@ impl SlotBoxes {
     /// bounds `min(a.max, o.max) > max(a.min, o.min)` on an axis is `a.max > o.min`,
     /// `o.max > a.min` and both boxes' own `max > min`, so the decisions (and the costs' bits)
     /// are the scalar test's.
-    fn overlapping(&self, o: &Aabb) -> u16 {
+    fn overlapping(&self, o: &Aabb) -> SlotMask {
         if !(o.max.x > o.min.x && o.max.y > o.min.y && o.max.z > o.min.z) {
             return 0;
         }
@@ -587,7 +599,7 @@ impl SlotBoxes {
         let [hx, hy, hz] = [o.max.x, o.max.y, o.max.z];
         let [min_x, min_y, min_z] = &self.min;
         let [max_x, max_y, max_z] = &self.max;
-        let mut mask = 0u16;
+        let mut mask: SlotMask = 0;
         for s in 0..LANES {
             let hit = (max_x[s] > lx)
                 & (hx > min_x[s])
@@ -595,14 +607,14 @@ impl SlotBoxes {
                 & (hy > min_y[s])
                 & (max_z[s] > lz)
                 & (hz > min_z[s]);
-            mask |= u16::from(hit) << s;
+            mask |= SlotMask::from(hit) << s;
         }
         mask & self.solid
     }
 }
 
 /// The set bits of a slot mask, lowest first (the slots' order of the scalar loops).
-fn slots_of(mut mask: u16) -> impl Iterator<Item = usize> {
+fn slots_of(mut mask: SlotMask) -> impl Iterator<Item = usize> {
     core::iter::from_fn(move || {
         (mask != 0).then(|| {
             let s = mask.trailing_zeros() as usize;
@@ -614,7 +626,7 @@ fn slots_of(mut mask: u16) -> impl Iterator<Item = usize> {
 
 /// Intersection volume of one interior waypoint's boxes; adds its gradient to the waypoint.
 /// Also whether any pair overlapped (added a volume and pulls).
-fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> (f32, bool) {
+fn intersection<const J: usize>(w: &mut Waypoint<J>, obstacles: &[ObstacleBox]) -> (f32, bool) {
     let mut total = 0.0;
     let mut hit = false;
     let Waypoint {
@@ -648,7 +660,7 @@ fn intersection(w: &mut Waypoint, obstacles: &[ObstacleBox]) -> (f32, bool) {
 /// Swept volume of the segment between two waypoints; each swept bound's share of the
 /// gradient goes to the end that set it (ties to the first end). Also whether any pair
 /// overlapped (added a volume and pulls).
-fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> (f32, bool) {
+fn swept<const J: usize>(a: &mut Waypoint<J>, b: &mut Waypoint<J>, obstacles: &[ObstacleBox]) -> (f32, bool) {
     let mut total = 0.0;
     let mut hit = false;
     // In an obstacle's frame the union of the two ends' AABBs lies in a ball around the
@@ -716,13 +728,13 @@ fn swept(a: &mut Waypoint, b: &mut Waypoint, obstacles: &[ObstacleBox]) -> (f32,
 /// Joint gradient of one waypoint from the gradient on its boxes' corners: each corner is a
 /// point moving with its body's frame (the held object's with the hand), and the FK adjoint
 /// takes it to the joints.
-fn waypoint_gradient(w: &Waypoint) -> Result<Joints<f32>, Error> {
+fn waypoint_gradient<const J: usize>(w: &Waypoint<J>) -> Result<Joints<f32, J>, Error> {
     let mut cot = Cotangent::new();
     for (s, (pulls, b)) in w.pulls.corners.iter().zip(w.boxes.iter()).enumerate() {
         if !b.active || w.pulls.touched & (1 << s) == 0 {
             continue;
         }
-        let frame = PANDA.bodies.get(s).map_or(HAND_FRAME, |body| body.frame);
+        let frame = w.k.robot.bodies.get(s).map_or(w.k.robot.hand_frame, |body| body.frame);
         for (corner, g) in pulls.iter().enumerate() {
             if *g != Vector3::zeros() {
                 cot.add_point(frame, &box_corner(&b.pose, &b.half, corner), g);
@@ -736,6 +748,7 @@ fn waypoint_gradient(w: &Waypoint) -> Result<Joints<f32>, Error> {
 mod tests {
     use super::*;
     use crate::robot::kinematics::forward;
+    use crate::robot::{HAND_FRAME, PANDA};
     use crate::scene::Obstacle;
 
     const ID: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
@@ -759,7 +772,10 @@ mod tests {
         let traj = [READY; 5];
         let mut g = [[1.0; 7]; 5];
         for kind in [CostKind::Intersection, CostKind::Swept] {
-            assert_eq!(trajectory_cost(&scene, &traj, &config(kind), Some(&mut g)), Ok(0.0));
+            assert_eq!(
+                trajectory_cost(&PANDA, &scene, &traj, &config(kind), Some(&mut g)),
+                Ok(0.0)
+            );
             assert!(g.iter().flatten().all(|&x| x == 0.0));
         }
     }
@@ -775,7 +791,7 @@ mod tests {
             .unwrap();
         let traj = [READY; 4];
         let mut g = [[0.0; 7]; 4];
-        let iv = trajectory_cost(&scene, &traj, &config(CostKind::Intersection), Some(&mut g)).unwrap();
+        let iv = trajectory_cost(&PANDA, &scene, &traj, &config(CostKind::Intersection), Some(&mut g)).unwrap();
         assert!(iv > 0.0);
         assert!(
             g[0].iter().chain(g[3].iter()).all(|&x| x == 0.0),
@@ -783,7 +799,7 @@ mod tests {
         );
         assert!(g[1].iter().any(|&x| x != 0.0));
         // A stationary trajectory sweeps exactly its boxes: sv over 3 segments = iv over 2 interior waypoints × 3/2.
-        let sv = trajectory_cost(&scene, &traj, &config(CostKind::Swept), None).unwrap();
+        let sv = trajectory_cost(&PANDA, &scene, &traj, &config(CostKind::Swept), None).unwrap();
         assert!((sv - iv * 1.5).abs() <= 1e-6 * sv, "{sv} vs {iv}");
     }
 
@@ -803,9 +819,12 @@ mod tests {
         let closed = scene.with_gripper(0.0).unwrap();
         for kind in [CostKind::Intersection, CostKind::Swept] {
             let mut g = [[1.0; 7]; 4];
-            assert_eq!(trajectory_cost(&open, &traj, &config(kind), Some(&mut g)), Ok(0.0));
+            assert_eq!(
+                trajectory_cost(&PANDA, &open, &traj, &config(kind), Some(&mut g)),
+                Ok(0.0)
+            );
             assert!(g.iter().flatten().all(|&x| x == 0.0));
-            let cost = trajectory_cost(&closed, &traj, &config(kind), Some(&mut g)).unwrap();
+            let cost = trajectory_cost(&PANDA, &closed, &traj, &config(kind), Some(&mut g)).unwrap();
             assert!(cost > 0.0, "{kind:?}");
             assert!(g.iter().flatten().any(|&x| x != 0.0), "{kind:?}");
         }
@@ -824,12 +843,12 @@ mod tests {
             expansion: 3e38,
         };
         assert_eq!(
-            trajectory_cost(&scene, &traj, &c, Some(&mut [[0.0; 7]; 5])),
+            trajectory_cost(&PANDA, &scene, &traj, &c, Some(&mut [[0.0; 7]; 5])),
             Err(Error::Overflow)
         );
         traj[3][2] = f32::NAN;
         assert_eq!(
-            trajectory_cost(&scene, &traj, &c, Some(&mut [[0.0; 7]; 5])),
+            trajectory_cost(&PANDA, &scene, &traj, &c, Some(&mut [[0.0; 7]; 5])),
             Err(Error::NonFiniteJoint { joint: 2 })
         );
     }
@@ -866,9 +885,9 @@ mod tests {
                 let mut c = config(kind);
                 c.inflation.clearance = 0.01 * (step / 20) as f32;
                 let (mut full, mut memoed) = ([[0.0; 7]; 16], [[9.0; 7]; 16]);
-                let want = trajectory_cost(&scene, &traj, &c, Some(&mut full)).unwrap();
+                let want = trajectory_cost(&PANDA, &scene, &traj, &c, Some(&mut full)).unwrap();
                 let quiet_before = memo.quiet;
-                let got = trajectory_cost_memo(&scene, &traj, &c, Some(&mut memoed), Some(&mut memo)).unwrap();
+                let got = trajectory_cost_memo(&PANDA, &scene, &traj, &c, Some(&mut memoed), Some(&mut memo)).unwrap();
                 assert_eq!(got.to_bits(), want.to_bits(), "{kind:?} step {step}");
                 let bits = |g: &[Joints<f32>; 16]| g.map(|q| q.map(f32::to_bits));
                 assert_eq!(bits(&memoed), bits(&full), "{kind:?} step {step}");
@@ -907,9 +926,9 @@ mod tests {
         for kind in [CostKind::Intersection, CostKind::Swept] {
             let c = config(kind);
             let mut memo = CostMemo::NONE;
-            let want = trajectory_cost(&scene, &traj, &c, None).unwrap();
+            let want = trajectory_cost(&PANDA, &scene, &traj, &c, None).unwrap();
             for _ in 0..2 {
-                let got = trajectory_cost_memo(&scene, &traj, &c, None, Some(&mut memo)).unwrap();
+                let got = trajectory_cost_memo(&PANDA, &scene, &traj, &c, None, Some(&mut memo)).unwrap();
                 assert_eq!(got.to_bits(), want.to_bits(), "{kind:?}");
             }
         }
@@ -922,12 +941,12 @@ mod tests {
         let c = config(CostKind::Swept);
         let mut traj: [Joints<f32>; 8] = sweep();
         let mut memo = CostMemo::NONE;
-        trajectory_cost_memo(&scene, &traj, &c, None, Some(&mut memo)).unwrap();
+        trajectory_cost_memo(&PANDA, &scene, &traj, &c, None, Some(&mut memo)).unwrap();
         // A change the memo is not told of, then forgotten: the full cost again.
         traj[3][0] += 0.3;
         memo.forget();
-        let want = trajectory_cost(&scene, &traj, &c, None).unwrap();
-        let got = trajectory_cost_memo(&scene, &traj, &c, None, Some(&mut memo)).unwrap();
+        let want = trajectory_cost(&PANDA, &scene, &traj, &c, None).unwrap();
+        let got = trajectory_cost_memo(&PANDA, &scene, &traj, &c, None, Some(&mut memo)).unwrap();
         assert_eq!(got.to_bits(), want.to_bits());
     }
 
@@ -936,8 +955,14 @@ mod tests {
         let scene = Scene::<1>::new();
         let mut c = config(CostKind::Swept);
         c.inflation.clearance = -0.1;
-        assert_eq!(trajectory_cost(&scene, &[READY; 3], &c, None), Err(Error::BadParameter));
+        assert_eq!(
+            trajectory_cost(&PANDA, &scene, &[READY; 3], &c, None),
+            Err(Error::BadParameter)
+        );
         c.inflation.clearance = f32::NAN;
-        assert_eq!(trajectory_cost(&scene, &[READY; 3], &c, None), Err(Error::BadParameter));
+        assert_eq!(
+            trajectory_cost(&PANDA, &scene, &[READY; 3], &c, None),
+            Err(Error::BadParameter)
+        );
     }
 }

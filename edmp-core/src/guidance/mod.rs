@@ -15,8 +15,8 @@ use crate::cost::{CostConfig, CostMemo, trajectory_cost_memo};
 use crate::error::Error;
 use crate::executor::{Executor, MAX_PARTS, split};
 use crate::guidance::guides::Guide;
+use crate::robot::Robot;
 use crate::robot::kinematics::Joints;
-use crate::robot::{JOINTS, PANDA};
 use crate::scene::Scene;
 
 /// Applies every row's guide once at diffusion step `t`, no joint of a waypoint moving more
@@ -31,14 +31,15 @@ use crate::scene::Scene;
 /// a fixed `t` a guide's step depends only on its rows, so the next step of a settled guide would
 /// be the same no-op: skipping it saves the work and changes no bit. Clear the flags whenever
 /// `t` (or the scene) changes. Any other length is [`Error::BadParameter`].
-pub fn guide_step<const H: usize, const N: usize>(
+pub fn guide_step<const H: usize, const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    rows: &mut [[Joints<f32>; H]],
-    grads: &mut [[Joints<f32>; H]],
+    rows: &mut [[Joints<f32, J>; H]],
+    grads: &mut [[Joints<f32, J>; H]],
     step: &GuideStep<'_>,
     settled: &mut [bool],
 ) -> Result<(), Error> {
-    step_rows(scene, rows, grads, step, settled, &mut [], None)
+    step_rows(robot, scene, rows, grads, step, settled, &mut [], None)
 }
 
 /// [`guide_step`] with the guides cut into groups run by `exec` (each group steps its own
@@ -48,29 +49,31 @@ pub fn guide_step<const H: usize, const N: usize>(
 /// segments that reached nothing at the last step and have not moved since (the same bits).
 /// Keep them for the steps at one `t` and start them at [`CostMemo::NONE`] whenever the rows
 /// change otherwise (a denoising step) or the scene does.
-pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
+#[allow(clippy::too_many_arguments)] // the arm, the scene, the batch and its working memory, the step
+pub fn guide_step_on<E: Executor, const H: usize, const N: usize, const J: usize>(
     exec: &E,
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    rows: &mut [[Joints<f32>; H]],
-    grads: &mut [[Joints<f32>; H]],
+    rows: &mut [[Joints<f32, J>; H]],
+    grads: &mut [[Joints<f32, J>; H]],
     step: &GuideStep<'_>,
     settled: &mut [bool],
     memos: &mut [CostMemo],
 ) -> Result<(), Error> {
     if exec.parts() <= 1 {
-        return step_rows(scene, rows, grads, step, settled, memos, None);
+        return step_rows(robot, scene, rows, grads, step, settled, memos, None);
     }
     let guides = step.guides;
     check_batch(rows.len(), grads.len(), guides.len(), settled.len(), memos.len())?;
-    struct Part<'a, const H: usize> {
+    struct Part<'a, const H: usize, const J: usize> {
         guides: &'a [Guide],
-        rows: &'a mut [[Joints<f32>; H]],
-        grads: &'a mut [[Joints<f32>; H]],
+        rows: &'a mut [[Joints<f32, J>; H]],
+        grads: &'a mut [[Joints<f32, J>; H]],
         settled: &'a mut [bool],
         memos: &'a mut [CostMemo],
     }
     let per_guide = rows.len() / guides.len();
-    let mut parts: heapless::Vec<Part<'_, H>, MAX_PARTS> = heapless::Vec::new();
+    let mut parts: heapless::Vec<Part<'_, H, J>, MAX_PARTS> = heapless::Vec::new();
     let (mut g_rest, mut r_rest, mut d_rest, mut s_rest, mut m_rest) = (guides, rows, grads, settled, memos);
     for &len in split(guides.len(), 1, exec.parts()).iter().filter(|&&l| l > 0) {
         let (rows_len, settled_len) = ((len * per_guide).min(r_rest.len()), len.min(s_rest.len()));
@@ -98,6 +101,7 @@ pub fn guide_step_on<E: Executor, const H: usize, const N: usize>(
     }
     exec.each(&mut parts, |p| {
         step_rows(
+            robot,
             scene,
             p.rows,
             p.grads,
@@ -157,9 +161,9 @@ pub struct StepRule {
 /// can tell). EDMP's fixed normalized steps never converge: near a minimum they bounce across
 /// it at full length.
 #[derive(Debug)]
-pub struct StepControl<'a, const H: usize> {
+pub struct StepControl<'a, const H: usize, const J: usize = { crate::robot::JOINTS }> {
     /// Each row where its guide's cost was last lowest (written by the control).
-    pub saved: &'a mut [[Joints<f32>; H]],
+    pub saved: &'a mut [[Joints<f32, J>; H]],
     /// Each guide's cost, summed over its rows, at `saved` (`+∞`: nothing accepted yet).
     pub best: &'a mut [f32],
     /// Each guide's step multiplier (1: the guide's own step).
@@ -171,30 +175,33 @@ pub const MIN_STEP_SCALE: f32 = 1.0 / 64.0;
 
 /// [`guide_step`] with step-size control ([`StepControl`], one entry per guide in `best` and
 /// `scale`, one saved row per row; other lengths are [`Error::BadParameter`]).
-pub fn guide_step_controlled<const H: usize, const N: usize>(
+pub fn guide_step_controlled<const H: usize, const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    rows: &mut [[Joints<f32>; H]],
-    grads: &mut [[Joints<f32>; H]],
+    rows: &mut [[Joints<f32, J>; H]],
+    grads: &mut [[Joints<f32, J>; H]],
     step: &GuideStep<'_>,
     settled: &mut [bool],
-    control: &mut StepControl<'_, H>,
+    control: &mut StepControl<'_, H, J>,
 ) -> Result<(), Error> {
     let guides = step.guides.len();
     if control.saved.len() != rows.len() || control.best.len() != guides || control.scale.len() != guides {
         return Err(Error::BadParameter);
     }
-    step_rows(scene, rows, grads, step, settled, &mut [], Some(control))
+    step_rows(robot, scene, rows, grads, step, settled, &mut [], Some(control))
 }
 
 #[inline(never)] // one symbol for profiles (benchmarks/stage_instructions.py); it is large anyway
-fn step_rows<const H: usize, const N: usize>(
+#[allow(clippy::too_many_arguments)] // the public entry points each pass a subset
+fn step_rows<const H: usize, const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    rows: &mut [[Joints<f32>; H]],
-    grads: &mut [[Joints<f32>; H]],
+    rows: &mut [[Joints<f32, J>; H]],
+    grads: &mut [[Joints<f32, J>; H]],
     step: &GuideStep<'_>,
     settled: &mut [bool],
     memos: &mut [CostMemo],
-    mut control: Option<&mut StepControl<'_, H>>,
+    mut control: Option<&mut StepControl<'_, H, J>>,
 ) -> Result<(), Error> {
     let GuideStep { guides, t, ref rule } = *step;
     let step_limit = rule.step_limit;
@@ -234,8 +241,8 @@ fn step_rows<const H: usize, const N: usize>(
         let mut norm2 = 0.0f32;
         let mut cost = 0.0f32;
         for (r, (row, grad)) in rows.iter().zip(grads.iter_mut()).enumerate() {
-            let clipped = row.map(|q| core::array::from_fn(|j| q[j].clamp(PANDA.hard_lower[j], PANDA.hard_upper[j])));
-            cost += trajectory_cost_memo(scene, &clipped, &config, Some(grad), memos.get_mut(r))?;
+            let clipped = row.map(|q| core::array::from_fn(|j| q[j].clamp(robot.hard_lower[j], robot.hard_upper[j])));
+            cost += trajectory_cost_memo(robot, scene, &clipped, &config, Some(grad), memos.get_mut(r))?;
             norm2 += grad[1..H - 1].iter().flatten().map(|g| g * g).sum::<f32>();
         }
         let mut multiplier = 1.0f32;
@@ -282,11 +289,7 @@ fn step_rows<const H: usize, const N: usize>(
             // The smoothness term acts only where the collision cost pulls: a row it leaves
             // alone stays put (and its guide can settle).
             let pulled = smooth > 0.0 && grad[1..H - 1].iter().flatten().any(|&v| v != 0.0);
-            let bend = if pulled {
-                bending_gradient(row)
-            } else {
-                [[0.0; JOINTS]; H]
-            };
+            let bend = if pulled { bending_gradient(row) } else { [[0.0; J]; H] };
             let mut waypoints_moved = 0u64;
             for (w, ((q, gq), bq)) in row[1..H - 1]
                 .iter_mut()
@@ -321,15 +324,15 @@ fn step_rows<const H: usize, const N: usize>(
 /// The gradient of the bending energy `½ Σ_{i=1}^{H−2} |q_{i−1} − 2 q_i + q_{i+1}|²` with respect
 /// to every waypoint (the ends' entries are not used): the smoothness term of a guide
 /// ([`Guide::smooth`]). An explicit step of weight `w` on it is stable for `w < 1/8`.
-pub fn bending_gradient<const H: usize>(row: &[Joints<f32>; H]) -> [Joints<f32>; H] {
-    let mut accel = [[0.0f32; JOINTS]; H];
+pub fn bending_gradient<const H: usize, const J: usize>(row: &[Joints<f32, J>; H]) -> [Joints<f32, J>; H] {
+    let mut accel = [[0.0f32; J]; H];
     for i in 1..H.saturating_sub(1) {
         accel[i] = core::array::from_fn(|j| row[i - 1][j] - 2.0 * row[i][j] + row[i + 1][j]);
     }
-    let mut grad = [[0.0f32; JOINTS]; H];
+    let mut grad = [[0.0f32; J]; H];
     for (k, gk) in grad.iter_mut().enumerate() {
-        let at = |i: usize| accel.get(i).copied().unwrap_or([0.0; JOINTS]);
-        let (before, here, after) = (k.checked_sub(1).map_or([0.0; JOINTS], at), at(k), at(k + 1));
+        let at = |i: usize| accel.get(i).copied().unwrap_or([0.0; J]);
+        let (before, here, after) = (k.checked_sub(1).map_or([0.0; J], at), at(k), at(k + 1));
         *gk = core::array::from_fn(|j| before[j] - 2.0 * here[j] + after[j]);
     }
     grad
@@ -338,6 +341,7 @@ pub fn bending_gradient<const H: usize>(row: &[Joints<f32>; H]) -> [Joints<f32>;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::robot::PANDA;
 
     /// One step of `guides` at `t`, joints limited to `step_limit`, enclosing boxes compared in
     /// the obstacle's frame.
@@ -380,7 +384,7 @@ mod tests {
             cylinder: CylinderBox::Enclosing,
             frame: BoxFrame::Obstacle,
         };
-        trajectory_cost(scene, x, &config, None).unwrap()
+        trajectory_cost(&PANDA, scene, x, &config, None).unwrap()
     }
 
     #[test]
@@ -401,6 +405,7 @@ mod tests {
                 ..*guide
             };
             guide_step(
+                &PANDA,
                 &scene,
                 &mut rows,
                 &mut grads,
@@ -432,6 +437,7 @@ mod tests {
         // Without memos: every segment of every row costed at every step.
         for _ in 0..6 {
             step_rows(
+                &PANDA,
                 &scene,
                 &mut whole,
                 &mut grads,
@@ -456,6 +462,7 @@ mod tests {
                 for _ in 0..6 {
                     guide_step_on(
                         &crate::executor::Reversed(parts),
+                        &PANDA,
                         &scene,
                         &mut rows,
                         &mut grads,
@@ -488,6 +495,7 @@ mod tests {
         let before = rows;
         let mut grads = [[[0.0; 7]; H]; 24];
         guide_step(
+            &PANDA,
             &empty,
             &mut rows,
             &mut grads,
@@ -524,8 +532,24 @@ mod tests {
         }
         let (mut g1, mut g2) = ([[[0.0; 7]; H]], [[[0.0; 7]; H]]);
         let (mut r1, mut r2) = ([wild], [clipped]);
-        guide_step(&scene, &mut r1, &mut g1, &step(&[guide], 50, f32::INFINITY), &mut []).unwrap();
-        guide_step(&scene, &mut r2, &mut g2, &step(&[guide], 50, f32::INFINITY), &mut []).unwrap();
+        guide_step(
+            &PANDA,
+            &scene,
+            &mut r1,
+            &mut g1,
+            &step(&[guide], 50, f32::INFINITY),
+            &mut [],
+        )
+        .unwrap();
+        guide_step(
+            &PANDA,
+            &scene,
+            &mut r2,
+            &mut g2,
+            &step(&[guide], 50, f32::INFINITY),
+            &mut [],
+        )
+        .unwrap();
         assert_eq!(g1, g2);
         assert!(
             g1[0][1..H - 1].iter().flatten().any(|g| *g != 0.0),
@@ -555,7 +579,7 @@ mod tests {
             let mut settled = [false; 2];
             for _ in 0..6 {
                 let flags: &mut [bool] = if tracked { &mut settled } else { &mut [] };
-                guide_step(&scene, &mut rows, &mut grads, &step(&guides, 1, 0.1), flags).unwrap();
+                guide_step(&PANDA, &scene, &mut rows, &mut grads, &step(&guides, 1, 0.1), flags).unwrap();
             }
             (rows, settled)
         };
@@ -572,7 +596,14 @@ mod tests {
         // One flag per guide or none.
         let mut rows = [through, away];
         let mut grads = [[[0.0; 7]; H]; 2];
-        let err = guide_step(&scene, &mut rows, &mut grads, &step(&guides, 1, 0.1), &mut [false; 3]);
+        let err = guide_step(
+            &PANDA,
+            &scene,
+            &mut rows,
+            &mut grads,
+            &step(&guides, 1, 0.1),
+            &mut [false; 3],
+        );
         assert_eq!(err, Err(Error::BadParameter));
     }
 
@@ -581,6 +612,7 @@ mod tests {
         let mut rows = [[[0.0f32; 7]; H]; 5];
         let mut grads = [[[0.0f32; 7]; H]; 5];
         let err = guide_step(
+            &PANDA,
             &Scene::<4>::new(),
             &mut rows,
             &mut grads,
@@ -591,6 +623,7 @@ mod tests {
         let mut short = [[[0.0f32; 7]; H]; 11];
         let mut twelve = [[[0.0f32; 7]; H]; 12];
         let err = guide_step(
+            &PANDA,
             &Scene::<4>::new(),
             &mut twelve,
             &mut short,
@@ -610,6 +643,7 @@ mod tests {
         let mut grads = [[[0.0; 7]; H]];
         let mut free = [line(a, b)];
         guide_step(
+            &PANDA,
             &scene,
             &mut free,
             &mut grads,
@@ -627,11 +661,26 @@ mod tests {
         };
         assert!(moved(&free) > 0.02, "the raw step is long: {}", moved(&free));
         let mut limited = [line(a, b)];
-        guide_step(&scene, &mut limited, &mut grads, &step(&[guide], 200, 0.02), &mut []).unwrap();
+        guide_step(
+            &PANDA,
+            &scene,
+            &mut limited,
+            &mut grads,
+            &step(&[guide], 200, 0.02),
+            &mut [],
+        )
+        .unwrap();
         assert!(moved(&limited) <= 0.02 + 1e-6, "{}", moved(&limited));
         assert!(moved(&limited) > 0.0);
         for bad in [0.0, -1.0, f32::NAN] {
-            let err = guide_step(&scene, &mut limited, &mut grads, &step(&[guide], 200, bad), &mut []);
+            let err = guide_step(
+                &PANDA,
+                &scene,
+                &mut limited,
+                &mut grads,
+                &step(&[guide], 200, bad),
+                &mut [],
+            );
             assert_eq!(err, Err(Error::BadParameter));
         }
     }
@@ -681,7 +730,7 @@ mod tests {
             let mut grads = [[[0.0; 7]; H]];
             let g = Guide { smooth, ..guide };
             for _ in 0..20 {
-                guide_step(scene, &mut rows, &mut grads, &step(&[g], 1, 0.1), &mut []).unwrap();
+                guide_step(&PANDA, scene, &mut rows, &mut grads, &step(&[g], 1, 0.1), &mut []).unwrap();
             }
             rows[0]
         };
@@ -722,6 +771,7 @@ mod tests {
                 scale: &mut scale,
             };
             guide_step_controlled(
+                &PANDA,
                 &scene,
                 &mut rows,
                 &mut grads,
@@ -745,6 +795,7 @@ mod tests {
         }
         assert!(scale.iter().any(|&s| s < 1.0), "some step was undone");
         let err = guide_step_controlled(
+            &PANDA,
             &scene,
             &mut rows,
             &mut grads,

@@ -10,11 +10,11 @@ use crate::planner::request::Request;
 use crate::planner::waves::in_waves;
 use crate::planner::workspace::Workspace;
 use crate::planner::workspace::{WaveChecks, WaveRows};
-use crate::prior::{Scratch, TimeEmbedding, check_joints, free_ends, initial_noise, inpaint, predict_noise_on};
+use crate::prior::{Scratch, check_joints, free_ends, initial_noise, inpaint};
 use crate::rng::Rng;
 
 /// Copies row `r mod draws` into every row `r ≥ draws`.
-fn spread_draws(rows: &mut [Path], draws: usize) {
+fn spread_draws<const J: usize>(rows: &mut [Path<J>], draws: usize) {
     for r in draws.max(1)..rows.len() {
         if let Some(&from) = rows.get(r % draws.max(1))
             && let Some(to) = rows.get_mut(r)
@@ -25,43 +25,43 @@ fn spread_draws(rows: &mut [Path], draws: usize) {
 }
 
 /// The guided reverse diffusion: `paths` end as the `B` candidates (not yet clamped or judged).
-pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize>(
-    req: &Request<'_, N>,
+pub fn denoise<const B: usize, const N: usize, const C: usize, const CAP: usize, const J: usize>(
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
     scratch: &mut Scratch<C>,
-    work: &mut Workspace<B, CAP>,
-    paths: &mut [Path; B],
+    work: &mut Workspace<B, CAP, J>,
+    paths: &mut [Path<J>; B],
 ) -> Result<(), Error> {
     let scratches = core::slice::from_mut(scratch);
     denoise_on(&Serial, req, rng, scratches, work, paths)
 }
 
 /// [`denoise`] with its work run by `exec` ([`plan_on`](crate::planner::plan_on)).
-pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
     scratches: &mut [Scratch<C>],
-    work: &mut Workspace<B, CAP>,
-    paths: &mut [Path; B],
+    work: &mut Workspace<B, CAP, J>,
+    paths: &mut [Path<J>; B],
 ) -> Result<(), Error> {
     req.config.sampler.validate()?;
     check_joints(req.start)?;
     check_joints(req.goal)?;
     in_waves(exec, req, work, paths, |wave_guides, rows, checks| {
-        denoise_wave::<E, B, N, C>(exec, &req.with_guides(wave_guides), rng, scratches, rows, checks)
+        denoise_wave::<E, B, N, C, J>(exec, &req.with_guides(wave_guides), rng, scratches, rows, checks)
     })
 }
 
 /// One wave of [`denoise_on`]: `rows` (paths, noise predictions, gradients) follow
 /// `req.guides` through the denoising steps and the refinement; `checks` (certified, touched)
 /// are what the refinement's checks learn of them.
-fn denoise_wave<E: Executor, const B: usize, const N: usize, const C: usize>(
+fn denoise_wave<E: Executor, const B: usize, const N: usize, const C: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
     scratches: &mut [Scratch<C>],
-    (paths, eps, grads): WaveRows<'_>,
+    (paths, eps, grads): WaveRows<'_, J>,
     checks: WaveChecks<'_>,
 ) -> Result<(), Error> {
     let Request {
@@ -79,17 +79,17 @@ fn denoise_wave<E: Executor, const B: usize, const N: usize, const C: usize>(
     spread_draws(paths, draws);
     for j in 0..config.sampler.evaluations() {
         let step = config.sampler.step(j);
-        let time = TimeEmbedding::new(step.t)?;
+        let time = req.network.time(step.t)?;
         if j == 0 && draws < rows {
             // Row r holds row r mod draws: so does its noise, bit for bit (a trajectory's
             // result does not depend on its batch).
             let (Some(drawn), Some(drawn_eps)) = (paths.get(..draws), eps.get_mut(..draws)) else {
                 return Err(Error::BadParameter);
             };
-            predict_noise_on(exec, drawn, &time, scratches, drawn_eps)?;
+            req.network.predict_noise_on(exec, drawn, &time, scratches, drawn_eps)?;
             spread_draws(eps, draws);
         } else {
-            predict_noise_on(exec, paths, &time, scratches, eps)?;
+            req.network.predict_noise_on(exec, paths, &time, scratches, eps)?;
         }
         for (x, e) in paths.iter_mut().zip(eps.iter()) {
             if config.condition {
@@ -99,12 +99,12 @@ fn denoise_wave<E: Executor, const B: usize, const N: usize, const C: usize>(
             }
         }
         let steps = config.guidance.steps_at(step.t);
-        guide_steps::<E, B, N>(exec, req, paths, grads, step.t, steps)?;
+        guide_steps::<E, B, N, J>(exec, req, paths, grads, step.t, steps)?;
     }
     if !config.condition {
         for x in paths.iter_mut() {
             inpaint(x, start, goal);
         }
     }
-    refine::<E, B, N>(exec, req, (paths, eps, grads), config.refine, checks)
+    refine::<E, B, N, J>(exec, req, (paths, eps, grads), config.refine, checks)
 }

@@ -28,7 +28,7 @@ use crate::planner::request::Request;
 use crate::planner::search::search_from;
 use crate::planner::waves::in_waves;
 use crate::planner::workspace::{RowChecks, Workspace};
-use crate::prior::{self, Sampler, Scratch, Step, TimeEmbedding, predict_noise_on};
+use crate::prior::{self, Sampler, Scratch, Step};
 use crate::rng::Rng;
 use crate::robot::kinematics::Joints;
 
@@ -36,13 +36,13 @@ use crate::robot::kinematics::Joints;
 /// place), with `req.config.global`'s settings (none is [`Error::BadParameter`]): when the
 /// search finds nothing, `plan` keeps the first stage's candidates (ranked in full) and the
 /// search's report.
-pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
     scratches: &mut [Scratch<C>],
-    work: &mut Workspace<B, CAP>,
-    plan: &mut Plan<B>,
+    work: &mut Workspace<B, CAP, J>,
+    plan: &mut Plan<B, J>,
 ) -> Result<(), Error> {
     let Request {
         scene,
@@ -56,14 +56,14 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
     };
     global.validate()?;
     let mut calls = 0u32;
-    let mut edge_free = |a: &Joints<f32>, b: &Joints<f32>| {
+    let mut edge_free = |a: &Joints<f32, J>, b: &Joints<f32, J>| {
         calls = calls.saturating_add(1);
-        check_segment(&crate::robot::PANDA, scene, a, b, [start, goal], &config.check)
+        check_segment(req.robot, scene, a, b, [start, goal], &config.check)
     };
     // The first stage's candidate with the lowest swept volume (first on ties): the one that
     // reaches least into the obstacles.
     let seed = if global.seeded {
-        let mut best: Option<(f32, &Path)> = None;
+        let mut best: Option<(f32, &Path<J>)> = None;
         for (x, v) in plan.paths.iter().zip(&plan.verdicts) {
             if best.is_none_or(|(swept, _)| v.swept < swept) {
                 best = Some((v.swept, x));
@@ -77,7 +77,16 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
     let mut attempts = 0u8;
     while found.is_none() && attempts < global.attempts {
         attempts += 1;
-        found = search_from(start, goal, seed, &global.search, &mut work.search, rng, &mut edge_free)?;
+        found = search_from(
+            req.robot,
+            start,
+            goal,
+            seed,
+            &global.search,
+            &mut work.search,
+            rng,
+            &mut edge_free,
+        )?;
     }
     let report = |found: bool, nodes: usize, iterations: u32| SearchReport {
         found,
@@ -109,15 +118,16 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
             let strided = Sampler::Strided { steps: global.steps };
             for j in 0..usize::from(global.steps) {
                 let step = Step::partial(global.noise_step, global.steps, j);
-                predict_noise_on(exec, paths, &TimeEmbedding::new(step.t)?, scratches, eps)?;
+                req.network
+                    .predict_noise_on(exec, paths, &req.network.time(step.t)?, scratches, eps)?;
                 for (x, e) in paths.iter_mut().zip(eps.iter()) {
                     strided.update(step, x, e, rng, start, goal);
                 }
                 if step.t >= 5 {
-                    guide_steps::<E, B, N>(exec, &wave, paths, grads, step.t, global.per_step)?;
+                    guide_steps::<E, B, N, J>(exec, &wave, paths, grads, step.t, global.per_step)?;
                 }
             }
-            refine::<E, B, N>(exec, &wave, (paths, eps, grads), global.refine, checks)
+            refine::<E, B, N, J>(exec, &wave, (paths, eps, grads), global.refine, checks)
         },
     )?;
     judge(req, plan, &work.checks)?;

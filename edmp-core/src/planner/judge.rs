@@ -13,24 +13,24 @@ use crate::planner::config::Judging;
 use crate::planner::plan::{Plan, Stage, Verdict};
 use crate::planner::request::Request;
 use crate::planner::workspace::RowChecks;
+use crate::robot::Robot;
 use crate::robot::kinematics::Joints;
-use crate::robot::{JOINTS, PANDA};
 
 /// The exact checker's word on the rows of `paths` not yet `certified`, judged as [`judge`]
 /// will judge them (clamped into the soft limits, ends exact), each walked from where it last
 /// `touched`: the number of certified rows after it. Each row's check is its own: `exec` may
 /// run them at once. Under [`Judging::Winner`] a group of `exec.parts()` rows at a time, until
 /// `need` are certified.
-pub(crate) fn certify<E: Executor, const B: usize, const N: usize>(
+pub(crate) fn certify<E: Executor, const B: usize, const N: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
-    paths: &[Path],
+    req: &Request<'_, N, J>,
+    paths: &[Path<J>],
     certified: &mut [bool],
     touched: &mut [Option<u16>],
     need: u8,
 ) -> Result<usize, Error> {
     let mut free = certified.iter().filter(|&&c| c).count();
-    let mut rows: heapless::Vec<(&Path, &mut bool, &mut Option<u16>), B> = heapless::Vec::new();
+    let mut rows: heapless::Vec<(&Path<J>, &mut bool, &mut Option<u16>), B> = heapless::Vec::new();
     for ((x, done), touched) in paths.iter().zip(certified.iter_mut()).zip(touched.iter_mut()) {
         if !*done && rows.push((x, done, touched)).is_err() {
             return Err(Error::BadParameter);
@@ -53,9 +53,9 @@ pub(crate) fn certify<E: Executor, const B: usize, const N: usize>(
         }
         exec.each(group, |(x, done, touched)| {
             let mut judged = **x;
-            clamp_for_judging(&mut judged, start, goal);
+            clamp_for_judging(req.robot, &mut judged, start, goal);
             let from = touched.map_or(0, usize::from);
-            let report = check_trajectory_from(&crate::robot::PANDA, scene, &judged, &config.check, from)?;
+            let report = check_trajectory_from(req.robot, scene, &judged, &config.check, from)?;
             **done = report.is_free();
             **touched = report.first_contact.map(|c| c.segment);
             Ok(())
@@ -66,10 +66,15 @@ pub(crate) fn certify<E: Executor, const B: usize, const N: usize>(
 }
 
 /// A candidate as the judge sees it: every joint clamped into the soft limits, the ends exact.
-pub(crate) fn clamp_for_judging(x: &mut Path, start: &Joints<f32>, goal: &Joints<f32>) {
+pub(crate) fn clamp_for_judging<const J: usize>(
+    robot: &Robot<f32, J>,
+    x: &mut Path<J>,
+    start: &Joints<f32, J>,
+    goal: &Joints<f32, J>,
+) {
     for q in x.iter_mut() {
         for (j, v) in q.iter_mut().enumerate() {
-            *v = v.clamp(PANDA.soft_lower[j], PANDA.soft_upper[j]);
+            *v = v.clamp(robot.soft_lower[j], robot.soft_upper[j]);
         }
     }
     x[0] = *start;
@@ -85,11 +90,11 @@ pub(crate) fn clamp_for_judging(x: &mut Path, start: &Joints<f32>, goal: &Joints
 /// candidate is checked state by state to the end either way, unless `checks` says the
 /// refinement's early stop already did (`Workspace::checks` after [`denoise`](crate::planner::denoise);
 /// [`RowChecks::NONE`]: check every candidate).
-pub fn select<const B: usize, const N: usize>(
-    req: &Request<'_, N>,
-    paths: [Path; B],
+pub fn select<const B: usize, const N: usize, const J: usize>(
+    req: &Request<'_, N, J>,
+    paths: [Path<J>; B],
     checks: &RowChecks<B>,
-) -> Result<Plan<B>, Error> {
+) -> Result<Plan<B, J>, Error> {
     let mut plan = Plan { paths, ..Plan::empty() };
     judge(req, &mut plan, checks)?;
     Ok(plan)
@@ -97,9 +102,9 @@ pub fn select<const B: usize, const N: usize>(
 
 /// [`select`] on the candidates already in `plan.paths`, in place (no copy of the batch: what
 /// keeps the firmware's stack small).
-pub fn judge<const B: usize, const N: usize>(
-    req: &Request<'_, N>,
-    plan: &mut Plan<B>,
+pub fn judge<const B: usize, const N: usize, const J: usize>(
+    req: &Request<'_, N, J>,
+    plan: &mut Plan<B, J>,
     checks: &RowChecks<B>,
 ) -> Result<(), Error> {
     if B == 0 {
@@ -121,7 +126,7 @@ pub fn judge<const B: usize, const N: usize>(
     };
     for ((x, verdict), &skipped) in paths.iter_mut().zip(verdicts.iter_mut()).zip(&checks.skipped) {
         if skipped {
-            *x = [[0.0; JOINTS]; HORIZON];
+            *x = [[0.0; J]; HORIZON];
             *verdict = Verdict {
                 swept: f32::INFINITY,
                 checked: false,
@@ -131,9 +136,9 @@ pub fn judge<const B: usize, const N: usize>(
             };
             continue;
         }
-        clamp_for_judging(x, start, goal);
+        clamp_for_judging(req.robot, x, start, goal);
         *verdict = Verdict {
-            swept: trajectory_cost(scene, x, &swept, None)?,
+            swept: trajectory_cost(req.robot, scene, x, &swept, None)?,
             checked: false,
             free: false,
             colliding_states: u32::MAX,
@@ -169,7 +174,7 @@ pub fn judge<const B: usize, const N: usize>(
             0
         } else {
             let from = touched.map_or(0, usize::from);
-            check_trajectory_from(&crate::robot::PANDA, scene, x, &config.check, from)?.colliding_states
+            check_trajectory_from(req.robot, scene, x, &config.check, from)?.colliding_states
         };
         verdict.checked = true;
         verdict.free = colliding_states == 0;
@@ -205,15 +210,17 @@ fn pick<const B: usize>(verdicts: &[Verdict; B]) -> usize {
 
 /// When no candidate is free: counts every candidate's colliding states in full and picks the
 /// least colliding one (the plan a caller gets with status "collision").
-pub fn rank_in_full<const B: usize, const N: usize>(req: &Request<'_, N>, plan: &mut Plan<B>) -> Result<(), Error> {
+pub fn rank_in_full<const B: usize, const N: usize, const J: usize>(
+    req: &Request<'_, N, J>,
+    plan: &mut Plan<B, J>,
+) -> Result<(), Error> {
     let Request { scene, config, .. } = *req;
     if plan.is_free() {
         return Ok(());
     }
     for (x, verdict) in plan.paths.iter().zip(plan.verdicts.iter_mut()) {
         if verdict.made {
-            verdict.colliding_states =
-                check_trajectory(&crate::robot::PANDA, scene, x, &config.check, false)?.colliding_states;
+            verdict.colliding_states = check_trajectory(req.robot, scene, x, &config.check, false)?.colliding_states;
         }
     }
     plan.best = pick(&plan.verdicts);

@@ -88,12 +88,12 @@ impl Observer for () {}
 /// Plans `req` with `B` rows (`B` a multiple of `req.guides.len()`), drawing every random
 /// number from `rng`: the same inputs give the same bits. [`denoise`] then [`judge`], then
 /// [`finish_on`] and [`polish`].
-pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize>(
-    req: &Request<'_, N>,
+pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize, const J: usize>(
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
     scratch: &mut Scratch<C>,
-    work: &mut Workspace<B, CAP>,
-) -> Result<Plan<B>, Error> {
+    work: &mut Workspace<B, CAP, J>,
+) -> Result<Plan<B, J>, Error> {
     let scratches = core::slice::from_mut(scratch);
     plan_observed(&Serial, req, rng, scratches, work, &mut ())
 }
@@ -101,25 +101,25 @@ pub fn plan<const B: usize, const N: usize, const C: usize, const CAP: usize>(
 /// [`plan`] with the network's batch, the guides and the refinement's checks cut into parts
 /// that `exec` runs (one part per scratch at most): the same bits as [`plan`] whatever the
 /// executor ([`crate::executor`]).
-pub fn plan_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+pub fn plan_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
     scratches: &mut [Scratch<C>],
-    work: &mut Workspace<B, CAP>,
-) -> Result<Plan<B>, Error> {
+    work: &mut Workspace<B, CAP, J>,
+) -> Result<Plan<B, J>, Error> {
     plan_observed(exec, req, rng, scratches, work, &mut ())
 }
 
 /// [`plan_on`], telling `observer` where each [`Phase`] begins and ends.
-pub fn plan_observed<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+pub fn plan_observed<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
     scratches: &mut [Scratch<C>],
-    work: &mut Workspace<B, CAP>,
+    work: &mut Workspace<B, CAP, J>,
     observer: &mut impl Observer,
-) -> Result<Plan<B>, Error> {
+) -> Result<Plan<B, J>, Error> {
     // One plan's memory throughout: denoised into, judged in place, reseeded in place.
     let mut plan = Plan::empty();
     observer.begin(Phase::FirstStage);
@@ -140,13 +140,13 @@ pub fn plan_observed<E: Executor, const B: usize, const N: usize, const C: usize
 /// After [`judge`]: a plan with a free candidate is done; otherwise the global stage runs
 /// when `req.config.global` asks for it ([`global::rescue`]), in place; `exec` runs its work
 /// ([`plan_on`]).
-pub fn finish_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize>(
+pub fn finish_on<E: Executor, const B: usize, const N: usize, const C: usize, const CAP: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
     scratches: &mut [Scratch<C>],
-    work: &mut Workspace<B, CAP>,
-    plan: &mut Plan<B>,
+    work: &mut Workspace<B, CAP, J>,
+    plan: &mut Plan<B, J>,
 ) -> Result<(), Error> {
     if req.config.global.is_some() && !plan.is_free() {
         rescue(exec, req, rng, scratches, work, plan)?;
@@ -157,10 +157,10 @@ pub fn finish_on<E: Executor, const B: usize, const N: usize, const C: usize, co
 /// After [`finish_on`]: a free winner is shortened over the exact checker when
 /// `req.config.shortcut` asks for it ([`shortcut::shorten`]), in place; its swept volume is
 /// recomputed.
-pub fn polish<const B: usize, const N: usize>(
-    req: &Request<'_, N>,
+pub fn polish<const B: usize, const N: usize, const J: usize>(
+    req: &Request<'_, N, J>,
     rng: &mut Rng,
-    plan: &mut Plan<B>,
+    plan: &mut Plan<B, J>,
 ) -> Result<(), Error> {
     let Request {
         scene,
@@ -179,8 +179,8 @@ pub fn polish<const B: usize, const N: usize>(
             frame: config.frame,
         };
         if let (Some(path), Some(verdict)) = (plan.paths.get_mut(plan.best), plan.verdicts.get_mut(plan.best)) {
-            let report = shorten(scene, [start, goal], &config.check, shortcut, rng, path)?;
-            verdict.swept = trajectory_cost(scene, path, &swept, None)?;
+            let report = shorten(req.robot, scene, [start, goal], &config.check, shortcut, rng, path)?;
+            verdict.swept = trajectory_cost(req.robot, scene, path, &swept, None)?;
             plan.shortcut = Some(report);
         }
     }

@@ -29,10 +29,10 @@ pub struct Verdict {
 /// The planner's output: every candidate (row `r` followed guide `r / k`), its verdict, and the
 /// chosen one.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Plan<const B: usize> {
+pub struct Plan<const B: usize, const J: usize = JOINTS> {
     /// The candidates, each inside the soft joint limits, starting at the start and ending at
     /// the goal.
-    pub paths: [Path; B],
+    pub paths: [Path<J>; B],
     /// The checker's and the swept cost's verdict on each.
     pub verdicts: [Verdict; B],
     /// Index of the chosen candidate: the free one with the lowest swept volume (lowest index on
@@ -48,11 +48,11 @@ pub struct Plan<const B: usize> {
     pub shortcut: Option<ShortcutReport>,
 }
 
-impl<const B: usize> Plan<B> {
+impl<const B: usize, const J: usize> Plan<B, J> {
     /// Zero candidates, not yet judged: the memory a plan is built in.
     pub const fn empty() -> Self {
         Self {
-            paths: [[[0.0; JOINTS]; HORIZON]; B],
+            paths: [[[0.0; J]; HORIZON]; B],
             verdicts: [Verdict {
                 swept: 0.0,
                 checked: false,

@@ -19,11 +19,11 @@ use crate::planner::workspace::{WaveChecks, WaveRows};
 /// be the same no-op, so this saves work and changes no bit
 /// ([`guide_step`](crate::guidance::guide_step)). `paths` holds at most `B` rows (a wave of
 /// them, [`PlanConfig::waves`](crate::planner::PlanConfig::waves)), following `req.guides`.
-pub(crate) fn guide_steps<E: Executor, const B: usize, const N: usize>(
+pub(crate) fn guide_steps<E: Executor, const B: usize, const N: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
-    paths: &mut [Path],
-    grads: &mut [Path],
+    req: &Request<'_, N, J>,
+    paths: &mut [Path<J>],
+    grads: &mut [Path<J>],
     t: u16,
     steps: u8,
 ) -> Result<(), Error> {
@@ -42,11 +42,11 @@ pub(crate) fn guide_steps<E: Executor, const B: usize, const N: usize>(
 
 /// One guidance step of `req.guides` at `t` with the plan's step limit and boxes, its guides
 /// run by `exec`.
-fn guide_once<E: Executor, const N: usize>(
+fn guide_once<E: Executor, const N: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
-    paths: &mut [Path],
-    grads: &mut [Path],
+    req: &Request<'_, N, J>,
+    paths: &mut [Path<J>],
+    grads: &mut [Path<J>],
     t: u16,
     settled: &mut [bool],
     memos: &mut [CostMemo],
@@ -56,7 +56,7 @@ fn guide_once<E: Executor, const N: usize>(
         t,
         rule: step_rule(req.config),
     };
-    guide_step_on(exec, req.scene, paths, grads, &step, settled, memos)
+    guide_step_on(exec, req.robot, req.scene, paths, grads, &step, settled, memos)
 }
 
 /// How the plan's guidance moves rows: its step limit and how its costs box things.
@@ -75,10 +75,10 @@ fn step_rule(config: &PlanConfig) -> StepRule {
 /// `req.guides`; their noise predictions are spent, and serve as working memory for the
 /// step-size control. `checks` (certified, touched) are what its checks learn of each row
 /// ([`RowChecks`](crate::planner::RowChecks)).
-pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
+pub(crate) fn refine<E: Executor, const B: usize, const N: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
-    (paths, saved, grads): WaveRows<'_>,
+    req: &Request<'_, N, J>,
+    (paths, saved, grads): WaveRows<'_, J>,
     steps: u8,
     (certified, touched): WaveChecks<'_>,
 ) -> Result<(), Error> {
@@ -126,7 +126,7 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
         if let Some(stop) = config.refine_stop
             && s.checked_rem(stop.every) == Some(0)
         {
-            let free = certify::<E, B, N>(exec, &req, paths, certified, touched, stop.free)?;
+            let free = certify::<E, B, N, J>(exec, &req, paths, certified, touched, stop.free)?;
             if free >= usize::from(stop.free) || (stop.stall > 0 && stalled >= u16::from(stop.stall)) {
                 return Ok(());
             }
@@ -145,7 +145,7 @@ pub(crate) fn refine<E: Executor, const B: usize, const N: usize>(
                 best: best.get_mut(..guides.len()).unwrap_or(&mut []),
                 scale: scale.get_mut(..guides.len()).unwrap_or(&mut []),
             };
-            guide_step_controlled(req.scene, paths, grads, &step, settled, &mut control)?;
+            guide_step_controlled(req.robot, req.scene, paths, grads, &step, settled, &mut control)?;
         } else {
             guide_once(exec, &req, paths, grads, 1, settled, memos)?;
             let mut progress = false;

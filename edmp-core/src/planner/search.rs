@@ -32,7 +32,7 @@ use crate::error::Error;
 use crate::path::{HORIZON, Path};
 use crate::rng::Rng;
 use crate::robot::kinematics::Joints;
-use crate::robot::{JOINTS, PANDA};
+use crate::robot::{JOINTS, Robot};
 use core::fmt;
 
 /// Link value that ends a chain while its parent links are reversed: never a node index,
@@ -126,13 +126,13 @@ impl Default for SearchConfig {
 ///
 /// Reusable: every [`search`] starts by clearing it. `new` is `const`, so on a
 /// microcontroller it can sit in a `static` instead of on the stack.
-pub struct SearchSpace<const CAP: usize> {
-    nodes: [[Joints<f32>; CAP]; 2],
+pub struct SearchSpace<const CAP: usize, const J: usize = JOINTS> {
+    nodes: [[Joints<f32, J>; CAP]; 2],
     parents: [[u16; CAP]; 2],
     len: [usize; 2],
 }
 
-impl<const CAP: usize> SearchSpace<CAP> {
+impl<const CAP: usize, const J: usize> SearchSpace<CAP, J> {
     /// Size of the space in bytes (for sizing statics and stacks).
     pub const BYTES: usize = core::mem::size_of::<Self>();
 
@@ -145,20 +145,20 @@ impl<const CAP: usize> SearchSpace<CAP> {
             );
         }
         Self {
-            nodes: [[[0.0; JOINTS]; CAP]; 2],
+            nodes: [[[0.0; J]; CAP]; 2],
             parents: [[0; CAP]; 2],
             len: [0; 2],
         }
     }
 }
 
-impl<const CAP: usize> Default for SearchSpace<CAP> {
+impl<const CAP: usize, const J: usize> Default for SearchSpace<CAP, J> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const CAP: usize> fmt::Debug for SearchSpace<CAP> {
+impl<const CAP: usize, const J: usize> fmt::Debug for SearchSpace<CAP, J> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("SearchSpace")
             .field("capacity", &CAP)
@@ -169,10 +169,10 @@ impl<const CAP: usize> fmt::Debug for SearchSpace<CAP> {
 
 /// A found path and what finding it cost.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SearchOutcome {
+pub struct SearchOutcome<const J: usize = JOINTS> {
     /// `HORIZON` waypoints from exactly the start to exactly the goal; every segment passed
     /// `edge_free`.
-    pub path: Path,
+    pub path: Path<J>,
     /// Waypoints of the shortcut polyline that `path` was resampled from (2 for a direct edge).
     pub corners: usize,
     /// `true` when the waypoints are evenly spaced by joint-space arc length; `false` when
@@ -197,15 +197,16 @@ pub struct SearchOutcome {
 ///
 /// Work: at most [`SearchConfig::max_oracle_calls`]`(CAP)` oracle calls; the rng advances by
 /// `JOINTS` numbers per iteration and two per shortcut attempt.
-pub fn search<const CAP: usize>(
-    start: &Joints<f32>,
-    goal: &Joints<f32>,
+pub fn search<const CAP: usize, const J: usize>(
+    robot: &Robot<f32, J>,
+    start: &Joints<f32, J>,
+    goal: &Joints<f32, J>,
     config: &SearchConfig,
-    space: &mut SearchSpace<CAP>,
+    space: &mut SearchSpace<CAP, J>,
     rng: &mut Rng,
-    edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
-) -> Result<Option<SearchOutcome>, Error> {
-    search_from(start, goal, &[], config, space, rng, edge_free)
+    edge_free: &mut impl FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
+) -> Result<Option<SearchOutcome<J>>, Error> {
+    search_from(robot, start, goal, &[], config, space, rng, edge_free)
 }
 
 /// [`search`] with trees that start from a seed path as well as from their roots: the start
@@ -216,19 +217,21 @@ pub fn search<const CAP: usize>(
 /// to bridge, instead of the whole way. The seed's first and last waypoints stand for the
 /// ends (they are not read); waypoints outside the soft limits end a chain (the trees stay
 /// within them). No randomness is used by the seeding: with an empty seed this is [`search`].
-pub fn search_from<const CAP: usize>(
-    start: &Joints<f32>,
-    goal: &Joints<f32>,
-    seed: &[Joints<f32>],
+#[allow(clippy::too_many_arguments)] // the arm, the problem, the budget and its memory, the oracle
+pub fn search_from<const CAP: usize, const J: usize>(
+    robot: &Robot<f32, J>,
+    start: &Joints<f32, J>,
+    goal: &Joints<f32, J>,
+    seed: &[Joints<f32, J>],
     config: &SearchConfig,
-    space: &mut SearchSpace<CAP>,
+    space: &mut SearchSpace<CAP, J>,
     rng: &mut Rng,
-    edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
-) -> Result<Option<SearchOutcome>, Error> {
+    edge_free: &mut impl FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
+) -> Result<Option<SearchOutcome<J>>, Error> {
     check_finite(start)?;
     check_finite(goal)?;
-    check_within_limits(start)?;
-    check_within_limits(goal)?;
+    check_within_limits(robot, start)?;
+    check_within_limits(robot, goal)?;
     config.validate()?;
     let capacity = config.tree_capacity(CAP);
     if capacity == 0 {
@@ -249,7 +252,7 @@ pub fn search_from<const CAP: usize>(
         space.len = [1, 1];
         2
     } else {
-        let Some((s, g)) = grow(start, goal, seed, config, space, rng, &mut oracle)? else {
+        let Some((s, g)) = grow(robot, start, goal, seed, config, space, rng, &mut oracle)? else {
             return Ok(None);
         };
         join(space, s, g)
@@ -285,11 +288,11 @@ pub fn search_from<const CAP: usize>(
 /// Random shortcuts on the polyline `path` over the caller's `edge_free` (see [`search`]): a
 /// pair of waypoints (i, j ≥ i + 2) is joined when the straight edge is free, dropping the
 /// waypoints between. Returns the new length and the oracle calls made (at most `attempts`).
-pub fn shortcut_polyline(
-    path: &mut [Joints<f32>],
+pub fn shortcut_polyline<const J: usize>(
+    path: &mut [Joints<f32, J>],
     attempts: u32,
     rng: &mut Rng,
-    edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+    edge_free: &mut impl FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 ) -> Result<(usize, u32), Error> {
     let mut oracle = Oracle {
         edge_free,
@@ -308,23 +311,26 @@ struct Oracle<'f, F> {
     iterations: u32,
 }
 
-impl<F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>> Oracle<'_, F> {
-    fn free(&mut self, a: &Joints<f32>, b: &Joints<f32>) -> Result<bool, Error> {
+impl<F> Oracle<'_, F> {
+    fn free<const J: usize>(&mut self, a: &Joints<f32, J>, b: &Joints<f32, J>) -> Result<bool, Error>
+    where
+        F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
+    {
         self.calls = self.calls.saturating_add(1);
         (self.edge_free)(a, b)
     }
 }
 
 /// One tree of the space, borrowed for growing.
-struct Tree<'a, const CAP: usize> {
-    nodes: &'a mut [Joints<f32>; CAP],
+struct Tree<'a, const CAP: usize, const J: usize> {
+    nodes: &'a mut [Joints<f32, J>; CAP],
     parents: &'a mut [u16; CAP],
     len: &'a mut usize,
     capacity: usize,
 }
 
-impl<const CAP: usize> Tree<'_, CAP> {
-    fn plant(&mut self, root: &Joints<f32>) {
+impl<const CAP: usize, const J: usize> Tree<'_, CAP, J> {
+    fn plant(&mut self, root: &Joints<f32, J>) {
         if let (Some(n), Some(p)) = (self.nodes.first_mut(), self.parents.first_mut()) {
             *n = *root;
             *p = 0;
@@ -332,13 +338,13 @@ impl<const CAP: usize> Tree<'_, CAP> {
         }
     }
 
-    fn grown(&self) -> &[Joints<f32>] {
+    fn grown(&self) -> &[Joints<f32, J>] {
         self.nodes.get(..*self.len).unwrap_or(&[])
     }
 
     /// Index and value of the node nearest to `q` (Euclidean; the first on ties).
-    fn nearest(&self, q: &Joints<f32>) -> Option<(usize, Joints<f32>)> {
-        let mut best: Option<(f32, usize, Joints<f32>)> = None;
+    fn nearest(&self, q: &Joints<f32, J>) -> Option<(usize, Joints<f32, J>)> {
+        let mut best: Option<(f32, usize, Joints<f32, J>)> = None;
         for (i, n) in self.grown().iter().enumerate() {
             let d = distance2(n, q);
             if best.is_none_or(|(b, _, _)| d < b) {
@@ -349,7 +355,7 @@ impl<const CAP: usize> Tree<'_, CAP> {
     }
 
     /// Appends `q` under `parent` (< the new index, which [`compact_chain`] relies on).
-    fn push(&mut self, q: Joints<f32>, parent: usize) -> Option<usize> {
+    fn push(&mut self, q: Joints<f32, J>, parent: usize) -> Option<usize> {
         let i = *self.len;
         if i >= self.capacity {
             return None;
@@ -375,14 +381,14 @@ enum Extension {
 }
 
 /// One step of `tree` from its nearest node towards `target`.
-fn extend<const CAP: usize, F>(
-    tree: &mut Tree<'_, CAP>,
-    target: &Joints<f32>,
+fn extend<const CAP: usize, F, const J: usize>(
+    tree: &mut Tree<'_, CAP, J>,
+    target: &Joints<f32, J>,
     step: f32,
     oracle: &mut Oracle<'_, F>,
 ) -> Result<Extension, Error>
 where
-    F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+    F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
     if *tree.len >= tree.capacity {
         return Ok(Extension::Full);
@@ -403,17 +409,19 @@ where
 
 /// Grows the start tree (space tree 0) and the goal tree (tree 1) in turn until they meet:
 /// the meeting node's index in each, or `None` when the budget runs out.
-fn grow<const CAP: usize, F>(
-    start: &Joints<f32>,
-    goal: &Joints<f32>,
-    seed: &[Joints<f32>],
+#[allow(clippy::too_many_arguments)]
+fn grow<const CAP: usize, F, const J: usize>(
+    robot: &Robot<f32, J>,
+    start: &Joints<f32, J>,
+    goal: &Joints<f32, J>,
+    seed: &[Joints<f32, J>],
     config: &SearchConfig,
-    space: &mut SearchSpace<CAP>,
+    space: &mut SearchSpace<CAP, J>,
     rng: &mut Rng,
     oracle: &mut Oracle<'_, F>,
 ) -> Result<Option<(usize, usize)>, Error>
 where
-    F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+    F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
     let capacity = config.tree_capacity(CAP);
     let SearchSpace {
@@ -436,8 +444,8 @@ where
     s.plant(start);
     g.plant(goal);
     let inner = seed.get(1..seed.len().saturating_sub(1)).unwrap_or(&[]);
-    let tip = grow_chain(&mut s, inner.iter(), oracle)?;
-    grow_chain(&mut g, inner.iter().rev(), oracle)?;
+    let tip = grow_chain(robot, &mut s, inner.iter(), oracle)?;
+    grow_chain(robot, &mut g, inner.iter().rev(), oracle)?;
     if let Some(tip) = tip
         && let Some(target) = s.grown().get(tip).copied()
     {
@@ -450,8 +458,8 @@ where
     let mut from_start = true;
     while oracle.iterations < config.max_iterations {
         oracle.iterations = oracle.iterations.saturating_add(1);
-        let mut sample = [0.0f32; JOINTS];
-        for ((v, lo), hi) in sample.iter_mut().zip(&PANDA.soft_lower).zip(&PANDA.soft_upper) {
+        let mut sample = [0.0f32; J];
+        for ((v, lo), hi) in sample.iter_mut().zip(&robot.soft_lower).zip(&robot.soft_upper) {
             *v = rng.uniform_f32(*lo, *hi);
         }
         let (a, b) = if from_start { (&mut s, &mut g) } else { (&mut g, &mut s) };
@@ -484,14 +492,14 @@ enum Connect {
 
 /// Greedy connect of `tree` to `target`: extensions until one is blocked or reaches it. Each
 /// pass adds a node or ends, so at most `capacity` passes.
-fn connect<const CAP: usize, F>(
-    tree: &mut Tree<'_, CAP>,
-    target: &Joints<f32>,
+fn connect<const CAP: usize, F, const J: usize>(
+    tree: &mut Tree<'_, CAP, J>,
+    target: &Joints<f32, J>,
     step: f32,
     oracle: &mut Oracle<'_, F>,
 ) -> Result<Connect, Error>
 where
-    F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+    F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
     loop {
         match extend(tree, target, step, oracle)? {
@@ -506,13 +514,14 @@ where
 /// Appends `chain` to `tree` from its root, each waypoint under the one before, while the edge
 /// to it is free and the waypoint lies within the soft limits (a repeat of the last node is
 /// skipped); the last node added, if any.
-fn grow_chain<'c, const CAP: usize, F>(
-    tree: &mut Tree<'_, CAP>,
-    chain: impl Iterator<Item = &'c Joints<f32>>,
+fn grow_chain<'c, const CAP: usize, F, const J: usize>(
+    robot: &Robot<f32, J>,
+    tree: &mut Tree<'_, CAP, J>,
+    chain: impl Iterator<Item = &'c Joints<f32, J>>,
     oracle: &mut Oracle<'_, F>,
 ) -> Result<Option<usize>, Error>
 where
-    F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+    F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
     let (mut last, mut added) = (0usize, None);
     for q in chain {
@@ -522,7 +531,7 @@ where
         if *q == from {
             continue;
         }
-        if check_finite(q).is_err() || check_within_limits(q).is_err() || !oracle.free(&from, q)? {
+        if check_finite(q).is_err() || check_within_limits(robot, q).is_err() || !oracle.free(&from, q)? {
             break;
         }
         let Some(i) = tree.push(*q, last) else {
@@ -536,7 +545,7 @@ where
 /// Lays the path out from the start: the start tree's chain root → `s` at flat positions
 /// `0..ls`, then the goal tree's chain after `g` (which equals `s`) down to its root.
 /// Returns the number of waypoints. The trees are spent afterwards.
-fn join<const CAP: usize>(space: &mut SearchSpace<CAP>, s: usize, g: usize) -> usize {
+fn join<const CAP: usize, const J: usize>(space: &mut SearchSpace<CAP, J>, s: usize, g: usize) -> usize {
     let SearchSpace {
         nodes: [n0, n1],
         parents: [p0, p1],
@@ -563,7 +572,11 @@ fn join<const CAP: usize>(space: &mut SearchSpace<CAP>, s: usize, g: usize) -> u
 /// Moves the chain root → `leaf` of one tree to positions `0..len` of its nodes, in that
 /// order; returns `len`. Parents have smaller indices than their children, so the chain's
 /// k-th node from the root sits at index ≥ k and is read before anything overwrites it.
-fn compact_chain<const CAP: usize>(nodes: &mut [Joints<f32>; CAP], parents: &mut [u16; CAP], leaf: usize) -> usize {
+fn compact_chain<const CAP: usize, const J: usize>(
+    nodes: &mut [Joints<f32, J>; CAP],
+    parents: &mut [u16; CAP],
+    leaf: usize,
+) -> usize {
     // Reverse the links so that they point from the root towards the leaf.
     let (mut prev, mut cur, mut len) = (NO_NODE, leaf, 0usize);
     while let Some(link) = parents.get_mut(cur) {
@@ -593,14 +606,14 @@ fn compact_chain<const CAP: usize>(nodes: &mut [Joints<f32>; CAP], parents: &mut
 
 /// Random shortcuts on the polyline `path`: a pair (i, j ≥ i + 2) is joined when the oracle
 /// frees the straight edge, dropping the waypoints between. Returns the new length.
-fn shortcut<F>(
-    path: &mut [Joints<f32>],
+fn shortcut<F, const J: usize>(
+    path: &mut [Joints<f32, J>],
     attempts: u32,
     rng: &mut Rng,
     oracle: &mut Oracle<'_, F>,
 ) -> Result<usize, Error>
 where
-    F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+    F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
     let mut n = path.len();
     for _ in 0..attempts {
@@ -632,8 +645,8 @@ where
 
 /// `HORIZON` points evenly spaced by joint-space arc length along `path` (ends exact). Public
 /// for the shortening of the chosen path ([`crate::planner::shortcut`]).
-pub fn resample_even(path: &[Joints<f32>]) -> Path {
-    let first = path.first().copied().unwrap_or_default();
+pub fn resample_even<const J: usize>(path: &[Joints<f32, J>]) -> Path<J> {
+    let first = path.first().copied().unwrap_or([0.0; J]);
     let last = path.last().copied().unwrap_or(first);
     let total: f32 = path.windows(2).map(segment_length).sum();
     let length_of = |seg: usize| path.get(seg..seg.saturating_add(2)).map_or(0.0, segment_length);
@@ -714,9 +727,9 @@ pub fn resample_through_vertices<const J: usize>(path: &[[f32; J]]) -> Option<[[
 }
 
 /// Every segment of `path` through the oracle, stopping at the first blocked one.
-fn verify<F>(path: &Path, oracle: &mut Oracle<'_, F>) -> Result<bool, Error>
+fn verify<F, const J: usize>(path: &Path<J>, oracle: &mut Oracle<'_, F>) -> Result<bool, Error>
 where
-    F: FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+    F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
     for w in path.windows(2) {
         if let [a, b] = w
@@ -728,7 +741,7 @@ where
     Ok(true)
 }
 
-fn check_finite(q: &Joints<f32>) -> Result<(), Error> {
+fn check_finite<const J: usize>(q: &Joints<f32, J>) -> Result<(), Error> {
     match q.iter().position(|v| !v.is_finite()) {
         Some(joint) => Err(Error::NonFiniteJoint {
             joint: u8::try_from(joint).unwrap_or(u8::MAX),
@@ -740,10 +753,10 @@ fn check_finite(q: &Joints<f32>) -> Result<(), Error> {
 /// Ends inside the soft limits (the spec's 1e-5 rad tolerance): the trees grow within them, and
 /// an end far outside would make path lengths overflow (a fuzz finding:
 /// `fuzz/artifacts-kept/search/nan-path-huge-start`).
-fn check_within_limits(q: &Joints<f32>) -> Result<(), Error> {
+fn check_within_limits<const J: usize>(robot: &Robot<f32, J>, q: &Joints<f32, J>) -> Result<(), Error> {
     let outside = q
         .iter()
-        .zip(PANDA.soft_lower.iter().zip(PANDA.soft_upper.iter()))
+        .zip(robot.soft_lower.iter().zip(robot.soft_upper.iter()))
         .position(|(v, (lo, hi))| !(*v >= lo - LIMIT_TOLERANCE && *v <= hi + LIMIT_TOLERANCE));
     match outside {
         Some(joint) => Err(Error::OutsideLimits {
@@ -782,7 +795,7 @@ fn lerp<const J: usize>(a: &[f32; J], b: &[f32; J], t: f32) -> [f32; J] {
 }
 
 /// `from` moved towards `to` by at most `step` on every joint (exactly `to` when in reach).
-fn steer(from: &Joints<f32>, to: &Joints<f32>, step: f32) -> Joints<f32> {
+fn steer<const J: usize>(from: &Joints<f32, J>, to: &Joints<f32, J>, step: f32) -> Joints<f32, J> {
     let widest = from.iter().zip(to).map(|(a, b)| (b - a).abs()).fold(0.0f32, f32::max);
     if widest <= step {
         return *to;
@@ -800,6 +813,7 @@ fn steer(from: &Joints<f32>, to: &Joints<f32>, step: f32) -> Joints<f32> {
 )]
 mod tests {
     use super::*;
+    use crate::robot::PANDA;
     use std::boxed::Box;
 
     // A -0.0 in the start: the output's ends must keep its bits.
@@ -861,7 +875,15 @@ mod tests {
             calls += 1;
             Ok(wall.is_none_or(|w| w.edge_free(a, b)))
         };
-        let out = search(&START, &GOAL, config, &mut space, &mut Rng::new(seed), &mut oracle);
+        let out = search(
+            &PANDA,
+            &START,
+            &GOAL,
+            config,
+            &mut space,
+            &mut Rng::new(seed),
+            &mut oracle,
+        );
         (out, calls)
     }
 
@@ -878,6 +900,7 @@ mod tests {
             Ok(wall.edge_free(a, b))
         };
         let out = search_from(
+            &PANDA,
             &START,
             &GOAL,
             seed_path,
@@ -1036,6 +1059,7 @@ mod tests {
         let mut space = std::boxed::Box::new(SearchSpace::<8>::new());
         let mut free = |_: &Joints<f32>, _: &Joints<f32>| Ok(true);
         let out = search(
+            &PANDA,
             &start,
             &goal,
             &SearchConfig::DEFAULT,
@@ -1046,6 +1070,7 @@ mod tests {
         assert_eq!(out.err(), Some(Error::OutsideLimits { joint: 0 }));
         let inside = [0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0];
         let out = search(
+            &PANDA,
             &inside,
             &goal,
             &SearchConfig::DEFAULT,
@@ -1114,12 +1139,12 @@ mod tests {
         bad[3] = f32::NAN;
         let cfg = SearchConfig::DEFAULT;
         assert_eq!(
-            search(&bad, &GOAL, &cfg, &mut space, &mut rng, &mut free),
+            search(&PANDA, &bad, &GOAL, &cfg, &mut space, &mut rng, &mut free),
             Err(Error::NonFiniteJoint { joint: 3 })
         );
         bad[3] = f32::INFINITY;
         assert_eq!(
-            search(&START, &bad, &cfg, &mut space, &mut rng, &mut free),
+            search(&PANDA, &START, &bad, &cfg, &mut space, &mut rng, &mut free),
             Err(Error::NonFiniteJoint { joint: 3 })
         );
         for config in [
@@ -1133,14 +1158,14 @@ mod tests {
             SearchConfig { max_nodes: 0, ..cfg },
         ] {
             assert_eq!(
-                search(&START, &GOAL, &config, &mut space, &mut rng, &mut free),
+                search(&PANDA, &START, &GOAL, &config, &mut space, &mut rng, &mut free),
                 Err(Error::BadParameter)
             );
         }
         // The oracle's own errors come back at once.
         let mut failing = |_: &Joints<f32>, _: &Joints<f32>| Err(Error::SegmentTooLong);
         assert_eq!(
-            search(&START, &GOAL, &cfg, &mut space, &mut rng, &mut failing),
+            search(&PANDA, &START, &GOAL, &cfg, &mut space, &mut rng, &mut failing),
             Err(Error::SegmentTooLong)
         );
     }
@@ -1158,8 +1183,8 @@ mod tests {
         let mut space = Box::new(SearchSpace::<1024>::new());
         let mut oracle = |a: &Joints<f32>, b: &Joints<f32>| Ok(GAPPED.edge_free(a, b));
         let cfg = SearchConfig::DEFAULT;
-        let first = search(&START, &GOAL, &cfg, &mut space, &mut Rng::new(9), &mut oracle);
-        let again = search(&START, &GOAL, &cfg, &mut space, &mut Rng::new(9), &mut oracle);
+        let first = search(&PANDA, &START, &GOAL, &cfg, &mut space, &mut Rng::new(9), &mut oracle);
+        let again = search(&PANDA, &START, &GOAL, &cfg, &mut space, &mut Rng::new(9), &mut oracle);
         assert_eq!(first, again);
         assert!(first.unwrap().is_some());
     }
@@ -1230,6 +1255,7 @@ mod tests {
         };
         let mut space = Box::new(SearchSpace::<2048>::new());
         let o = search(
+            &PANDA,
             &START,
             &GOAL,
             &SearchConfig::DEFAULT,
@@ -1251,6 +1277,7 @@ mod tests {
             Ok(widest >= 0.2 && GAPPED.edge_free(a, b))
         };
         let none = search(
+            &PANDA,
             &START,
             &GOAL,
             &SearchConfig::DEFAULT,

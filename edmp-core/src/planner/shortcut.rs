@@ -29,6 +29,7 @@ use crate::error::Error;
 use crate::path::{HORIZON, Path};
 use crate::planner::search::{resample_even, resample_through_vertices, segment_length, shortcut_polyline};
 use crate::rng::Rng;
+use crate::robot::Robot;
 use crate::robot::kinematics::Joints;
 use crate::scene::Scene;
 
@@ -76,13 +77,14 @@ pub struct ShortcutReport {
 /// Shortens the free trajectory `path` from `start` to `goal` in `scene`, in place; `path`
 /// changes only to trajectories that pass `check` in full (the same rule as the selection:
 /// `end_margin` near the ends, `margin` elsewhere). Call it on a path that passed `check`.
-pub fn shorten<const N: usize>(
+pub fn shorten<const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    [start, goal]: [&Joints<f32>; 2],
+    [start, goal]: [&Joints<f32, J>; 2],
     check: &CheckConfig,
     config: &ShortcutConfig,
     rng: &mut Rng,
-    path: &mut Path,
+    path: &mut Path<J>,
 ) -> Result<ShortcutReport, Error> {
     let length_before = length(path);
     let mut report = ShortcutReport {
@@ -91,12 +93,10 @@ pub fn shorten<const N: usize>(
         dropped: 0,
         smoothing: 0,
     };
-    let free = |p: &Path| -> Result<bool, Error> {
-        Ok(check_trajectory(&crate::robot::PANDA, scene, p, check, true)?.is_free())
-    };
+    let free = |p: &Path<J>| -> Result<bool, Error> { Ok(check_trajectory(robot, scene, p, check, true)?.is_free()) };
     let mut polyline = *path;
     let mut edge_free =
-        |a: &Joints<f32>, b: &Joints<f32>| check_segment(&crate::robot::PANDA, scene, a, b, [start, goal], check);
+        |a: &Joints<f32, J>, b: &Joints<f32, J>| check_segment(robot, scene, a, b, [start, goal], check);
     let n = greedy(&mut polyline, config.greedy_checks, &mut edge_free)?;
     let (n, _) = match polyline.get_mut(..n) {
         Some(kept) => shortcut_polyline(kept, config.attempts, rng, &mut edge_free)?,
@@ -155,10 +155,10 @@ pub fn shorten<const N: usize>(
 /// the later waypoints: the last one first, then halves; visibility is not monotone, so this
 /// finds a far free one, not always the farthest), in place. Returns the number kept. The
 /// segment to the next waypoint is never asked: the path passed the checker.
-fn greedy(
-    path: &mut Path,
+fn greedy<const J: usize>(
+    path: &mut Path<J>,
     budget: u32,
-    edge_free: &mut impl FnMut(&Joints<f32>, &Joints<f32>) -> Result<bool, Error>,
+    edge_free: &mut impl FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 ) -> Result<usize, Error> {
     let last = HORIZON.saturating_sub(1);
     let (mut kept, mut i, mut checks) = (0usize, 0usize, 0u32);
@@ -191,7 +191,7 @@ fn greedy(
 }
 
 /// One Laplacian pass over the interior waypoints (the ends stay exact).
-fn laplacian(path: &Path) -> Path {
+fn laplacian<const J: usize>(path: &Path<J>) -> Path<J> {
     let mut out = *path;
     for (slot, w) in out.iter_mut().skip(1).zip(path.windows(3)) {
         if let [a, b, c] = w {
@@ -204,7 +204,7 @@ fn laplacian(path: &Path) -> Path {
 }
 
 /// Joint-space length: the sum of the Euclidean steps.
-fn length(path: &Path) -> f32 {
+fn length<const J: usize>(path: &Path<J>) -> f32 {
     path.windows(2).map(segment_length).sum()
 }
 
@@ -218,6 +218,7 @@ fn length(path: &Path) -> f32 {
 )]
 mod tests {
     use super::*;
+    use crate::robot::PANDA;
     use crate::scene::Obstacle;
 
     const START: Joints<f32> = [0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
@@ -259,6 +260,7 @@ mod tests {
                 .is_free()
         );
         let report = shorten(
+            &PANDA,
             &scene,
             [&START, &GOAL],
             &check,
@@ -303,6 +305,7 @@ mod tests {
             "the detour passes the wall"
         );
         shorten(
+            &PANDA,
             &scene,
             [&START, &GOAL],
             &check,
@@ -325,6 +328,7 @@ mod tests {
         let run = |seed| {
             let mut path = detour();
             shorten(
+                &PANDA,
                 &scene,
                 [&START, &GOAL],
                 &check,
@@ -405,7 +409,16 @@ mod tests {
             }
             let mut reference = path;
             let kept = step_by_step(&scene, &check, &config, case, &mut reference);
-            let report = shorten(&scene, [&START, &GOAL], &check, &config, &mut Rng::new(case), &mut path).unwrap();
+            let report = shorten(
+                &PANDA,
+                &scene,
+                [&START, &GOAL],
+                &check,
+                &config,
+                &mut Rng::new(case),
+                &mut path,
+            )
+            .unwrap();
             assert!(
                 check_trajectory(&crate::robot::PANDA, &scene, &path, &check, true)
                     .unwrap()

@@ -36,6 +36,8 @@ const GOAL: Joints<f32> = [-0.6, 0.2, 0.0, -2.0, 0.0, 2.2, 0.785];
 /// The problem from [`START`] to [`GOAL`] in `scene` with EDMP's guides and `config`.
 fn request<'a>(scene: &'a Scene<4>, config: &'a PlanConfig) -> Request<'a, 4> {
     Request {
+        robot: &PANDA,
+        network: crate::prior::PANDA,
         scene,
         start: &START,
         goal: &GOAL,
@@ -73,6 +75,8 @@ fn plan_wall<const B: usize, const C: usize>(
 ) -> Result<Plan<B>, Error> {
     plan(
         &Request {
+            robot: &PANDA,
+            network: crate::prior::PANDA,
             scene: &wall_scene(),
             start: &START,
             goal,
@@ -317,7 +321,7 @@ fn refine_batch(
     let mut paths = mixed_batch();
     let mut grads = [[[0.0; JOINTS]; HORIZON]; 12];
     let mut saved = grads;
-    refine::<_, 12, 4>(
+    refine::<_, 12, 4, 7>(
         &Serial,
         &request(scene, cfg),
         (&mut paths, &mut saved, &mut grads),
@@ -460,7 +464,7 @@ fn the_refinement_stops_on_the_checkers_word_and_keeps_certified_rows() {
     let batch = mixed_batch();
     let free = |x: &Path| {
         let mut judged = *x;
-        clamp_for_judging(&mut judged, &START, &GOAL);
+        clamp_for_judging(&PANDA, &mut judged, &START, &GOAL);
         check_trajectory(&crate::robot::PANDA, &scene, &judged, &CheckConfig::default(), true)
             .unwrap()
             .is_free()
@@ -637,6 +641,8 @@ fn each_wave_is_the_plan_of_its_guides_alone_and_rows_keep_the_callers_order() {
         let single = PlanConfig { waves: 1, ..cfg };
         denoise(
             &Request {
+                robot: &PANDA,
+                network: crate::prior::PANDA,
                 scene: &scene,
                 start: &START,
                 goal: &GOAL,

@@ -18,12 +18,12 @@ use crate::planner::workspace::{RowChecks, WaveChecks, WaveRows, Workspace};
 /// caller's order (row r follows guide r / k whatever the waves). Shared by the first stage
 /// ([`denoise_on`](crate::planner::denoise_on)) and the global stage's reseeding
 /// ([`crate::planner::global`]).
-pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: usize>(
+pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: usize, const J: usize>(
     exec: &E,
-    req: &Request<'_, N>,
-    work: &mut Workspace<B, CAP>,
-    paths: &mut [Path; B],
-    mut wave: impl FnMut(&[Guide], WaveRows<'_>, WaveChecks<'_>) -> Result<(), Error>,
+    req: &Request<'_, N, J>,
+    work: &mut Workspace<B, CAP, J>,
+    paths: &mut [Path<J>; B],
+    mut wave: impl FnMut(&[Guide], WaveRows<'_, J>, WaveChecks<'_>) -> Result<(), Error>,
 ) -> Result<(), Error> {
     let guides = req.guides;
     if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) {
@@ -59,7 +59,7 @@ pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: u
         ran = w + 1;
         // A later wave runs only when no row of this one is free (the judge would check them
         // the same way; what is learnt here it does not check again).
-        if ran < waves && certify::<E, B, N>(exec, req, x, free, touched, 1)? > 0 {
+        if ran < waves && certify::<E, B, N, J>(exec, req, x, free, touched, 1)? > 0 {
             break;
         }
     }

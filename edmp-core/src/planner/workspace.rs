@@ -12,26 +12,26 @@ pub const DEFAULT_SEARCH_NODES: usize = 512;
 /// Working memory of the planner for `B` rows (gradients and noise predictions) and of the
 /// global stage's search (`CAP` nodes per tree).
 #[derive(Debug)]
-pub struct Workspace<const B: usize, const CAP: usize = DEFAULT_SEARCH_NODES> {
-    pub(crate) eps: [Path; B],
-    pub(crate) grads: [Path; B],
+pub struct Workspace<const B: usize, const CAP: usize = DEFAULT_SEARCH_NODES, const J: usize = JOINTS> {
+    pub(crate) eps: [Path<J>; B],
+    pub(crate) grads: [Path<J>; B],
     /// What the refinement's checks learned of each row, for the judge ([`RefineStop`](crate::planner::RefineStop)).
     pub checks: RowChecks<B>,
-    pub(crate) search: SearchSpace<CAP>,
+    pub(crate) search: SearchSpace<CAP, J>,
 }
 
-impl<const B: usize, const CAP: usize> Default for Workspace<B, CAP> {
+impl<const B: usize, const CAP: usize, const J: usize> Default for Workspace<B, CAP, J> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const B: usize, const CAP: usize> Workspace<B, CAP> {
+impl<const B: usize, const CAP: usize, const J: usize> Workspace<B, CAP, J> {
     /// Zeroed working memory (`const`: it can live in a `static`).
     pub const fn new() -> Self {
         Self {
-            eps: [[[0.0; JOINTS]; HORIZON]; B],
-            grads: [[[0.0; JOINTS]; HORIZON]; B],
+            eps: [[[0.0; J]; HORIZON]; B],
+            grads: [[[0.0; J]; HORIZON]; B],
             checks: RowChecks::NONE,
             search: SearchSpace::new(),
         }
@@ -62,6 +62,6 @@ impl<const B: usize> RowChecks<B> {
 }
 
 /// One wave's share of the batch: its rows' paths, noise predictions and gradients.
-pub(crate) type WaveRows<'a> = (&'a mut [Path], &'a mut [Path], &'a mut [Path]);
+pub(crate) type WaveRows<'a, const J: usize> = (&'a mut [Path<J>], &'a mut [Path<J>], &'a mut [Path<J>]);
 /// The refinement's checks of one wave's rows: certified free, where each touched.
 pub(crate) type WaveChecks<'a> = (&'a mut [bool], &'a mut [Option<u16>]);

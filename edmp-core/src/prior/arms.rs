@@ -8,6 +8,7 @@
     missing_docs,
     unreachable_pub,
     unused_imports,
+    unused_macros,
     dead_code,
     clippy::unreadable_literal,
     clippy::excessive_precision

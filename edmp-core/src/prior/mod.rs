@@ -17,7 +17,7 @@ pub use net::{Network, Scratch, TimeEmbedding, predict_noise, predict_noise_on};
 pub use weights::{DIMS, LENGTHS, LEVELS, MACS, PARAMETERS, STEPS, WEIGHT_BYTES, WEIGHTS_FNV1A};
 
 use crate::Error;
-use crate::path::{HORIZON, Path, PathOf};
+use crate::path::{HORIZON, Path};
 use crate::rng::Rng;
 use crate::robot::JOINTS;
 
@@ -105,8 +105,8 @@ impl Sampler {
     pub fn update<const J: usize>(
         &self,
         step: Step,
-        x: &mut PathOf<J>,
-        eps: &PathOf<J>,
+        x: &mut Path<J>,
+        eps: &Path<J>,
         rng: &mut Rng,
         start: &[f32; J],
         goal: &[f32; J],
@@ -117,7 +117,7 @@ impl Sampler {
 
     /// [`Self::update`] without the inpainting: every waypoint, the ends included, follows the
     /// network (the paper's "without conditioning" ablation, Table IV).
-    pub fn advance<const J: usize>(&self, step: Step, x: &mut PathOf<J>, eps: &PathOf<J>, rng: &mut Rng) {
+    pub fn advance<const J: usize>(&self, step: Step, x: &mut Path<J>, eps: &Path<J>, rng: &mut Rng) {
         let i = table_index(step.t);
         match *self {
             Self::Ancestral => {
@@ -191,7 +191,7 @@ impl Step {
 /// The forward process q(x_t | x_0): `x ← √ᾱ_t·x + √(1−ᾱ_t)·ε` (standard normals from `rng`,
 /// waypoint-major), then the ends written in: how a trajectory found elsewhere is handed to the
 /// prior at an intermediate step (SDEdit), to be denoised from there.
-pub fn diffuse<const J: usize>(x: &mut PathOf<J>, t: u16, rng: &mut Rng, start: &[f32; J], goal: &[f32; J]) {
+pub fn diffuse<const J: usize>(x: &mut Path<J>, t: u16, rng: &mut Rng, start: &[f32; J], goal: &[f32; J]) {
     let i = table_index(t);
     let (a, n) = (weights::SQRT_ALPHA_BAR[i], weights::SQRT_ONE_MINUS_ALPHA_BAR[i]);
     for v in x.iter_mut().flatten() {
@@ -207,13 +207,13 @@ fn table_index(t: u16) -> usize {
 }
 
 /// Writes the start and the goal into the first and last waypoints.
-pub fn inpaint<const J: usize>(x: &mut PathOf<J>, start: &[f32; J], goal: &[f32; J]) {
+pub fn inpaint<const J: usize>(x: &mut Path<J>, start: &[f32; J], goal: &[f32; J]) {
     x[0] = *start;
     x[HORIZON - 1] = *goal;
 }
 
 /// The sampler's starting point: standard normal entries (waypoint-major), then inpainted.
-pub fn initial_noise<const J: usize>(x: &mut PathOf<J>, rng: &mut Rng, start: &[f32; J], goal: &[f32; J]) {
+pub fn initial_noise<const J: usize>(x: &mut Path<J>, rng: &mut Rng, start: &[f32; J], goal: &[f32; J]) {
     for v in x.iter_mut().flatten() {
         *v = rng.normal_f32();
     }
@@ -222,7 +222,7 @@ pub fn initial_noise<const J: usize>(x: &mut PathOf<J>, rng: &mut Rng, start: &[
 
 /// Redraws the two ends of an [`initial_noise`] as standard normals (a second, independent
 /// draw): the starting point of the unconditioned ablation.
-pub fn free_ends<const J: usize>(x: &mut PathOf<J>, rng: &mut Rng) {
+pub fn free_ends<const J: usize>(x: &mut Path<J>, rng: &mut Rng) {
     for w in [0, HORIZON - 1] {
         for v in x[w].iter_mut() {
             *v = rng.normal_f32();
@@ -277,7 +277,7 @@ pub fn sample_with<const J: usize, const B: usize, const C: usize>(
     goal: &[f32; J],
     rng: &mut Rng,
     scratch: &mut Scratch<C>,
-    out: &mut [PathOf<J>; B],
+    out: &mut [Path<J>; B],
 ) -> Result<(), Error> {
     sampler.validate()?;
     check_joints(start)?;

@@ -57,9 +57,8 @@ impl<T: Real> Pose<T> {
     }
 }
 
-/// Joint angles of the Panda's 7 actuated joints, radians (the planner's joint vector until it
-/// is generic over the arm).
-pub type Joints<T> = [T; crate::robot::JOINTS];
+/// Joint angles of an arm's `J` actuated joints, radians (the Panda's 7 unless named).
+pub type Joints<T, const J: usize = { crate::robot::JOINTS }> = [T; J];
 
 /// Corner `k` of a box has sign `+` on axis `i` where bit `i` of `k` is set.
 pub const CORNERS: usize = 8;

@@ -18,6 +18,7 @@ use edmp_core::guidance::guides::EDMP_GUIDES;
 use edmp_core::planner::{Plan, PlanConfig, Request, Workspace, plan};
 use edmp_core::prior::Scratch;
 use edmp_core::rng::Rng;
+use edmp_core::robot::{JOINTS, PANDA};
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
 use edmp_core::surface::bvh::nodes_for;
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
@@ -161,8 +162,10 @@ pub fn plan_like_firmware(bytes: &[u8]) -> Result<Plan<ROWS>, String> {
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<ROWS>::new());
     let mut rng = Rng::new(problem.seed);
-    plan::<ROWS, MAX_OBSTACLES, 4, { edmp_core::planner::DEFAULT_SEARCH_NODES }>(
+    plan::<ROWS, MAX_OBSTACLES, 4, { edmp_core::planner::DEFAULT_SEARCH_NODES }, JOINTS>(
         &Request {
+            robot: &PANDA,
+            network: edmp_core::prior::PANDA,
             scene: &scene,
             start: &problem.start,
             goal: &problem.goal,

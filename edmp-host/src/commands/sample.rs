@@ -13,7 +13,7 @@ use crate::commands::render::Canvas;
 use crate::formats::json::{Goal, read_problem};
 use crate::metrics::{Roughness, roughness, step_norm};
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
-use edmp_core::path::{HORIZON, PathOf};
+use edmp_core::path::{HORIZON, Path};
 use edmp_core::prior::{Network, Sampler, Scratch, sample_with};
 use edmp_core::rng::Rng;
 use edmp_core::robot::Robot;
@@ -106,7 +106,7 @@ struct Quality {
     self_colliding: bool,
 }
 
-fn quality<const J: usize>(robot: &'static Robot<f32, J>, x: &PathOf<J>, empty: &Scene<1>) -> Quality {
+fn quality<const J: usize>(robot: &'static Robot<f32, J>, x: &Path<J>, empty: &Scene<1>) -> Quality {
     let outside_limits = x.iter().flatten().enumerate().any(|(i, v)| {
         let j = i % J;
         *v < robot.hard_lower[j] || *v > robot.hard_upper[j]
@@ -140,7 +140,7 @@ fn row(label: &str, q: &[Quality], ms: Option<(f64, f64)>) -> String {
     )
 }
 
-fn read_npy<const J: usize>(path: &std::path::Path) -> Result<Vec<PathOf<J>>, String> {
+fn read_npy<const J: usize>(path: &std::path::Path) -> Result<Vec<Path<J>>, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let bad = || {
         format!(
@@ -244,7 +244,7 @@ fn measure<const J: usize>(robot: &'static Robot<f32, J>, network: &Network<J>, 
             d(*a).total_cmp(&d(*b))
         })
         .unwrap_or(0);
-    let mut plotted: Vec<(Sampler, [PathOf<J>; BATCH])> = Vec::new();
+    let mut plotted: Vec<(Sampler, [Path<J>; BATCH])> = Vec::new();
     let conditions: &[bool] = if args.no_conditioning { &[true, false] } else { &[true] };
     let runs: Vec<(Sampler, bool)> = samplers
         .iter()
@@ -261,7 +261,7 @@ fn measure<const J: usize>(robot: &'static Robot<f32, J>, network: &Network<J>, 
                 .map_err(|e| e.to_string())?,
         );
         bar.set_message(label.clone());
-        let results: Vec<Result<(f64, [PathOf<J>; BATCH]), String>> = problems
+        let results: Vec<Result<(f64, [Path<J>; BATCH]), String>> = problems
             .par_iter()
             .enumerate()
             .map(|(i, (start, goal))| {
@@ -322,8 +322,8 @@ fn measure<const J: usize>(robot: &'static Robot<f32, J>, network: &Network<J>, 
 fn plot<const J: usize>(
     robot: &Robot<f32, J>,
     path: &std::path::Path,
-    a: &[PathOf<J>; BATCH],
-    b: &[PathOf<J>; BATCH],
+    a: &[Path<J>; BATCH],
+    b: &[Path<J>; BATCH],
 ) -> Result<(), String> {
     const W: usize = 900;
     const PANEL_H: usize = 110;

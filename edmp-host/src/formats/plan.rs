@@ -12,8 +12,8 @@ use edmp_core::cost::boxes::Inflation;
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::guidance::guides::Guide;
 use edmp_core::planner::{Plan, PlanConfig};
-use edmp_core::robot::JOINTS;
 use edmp_core::robot::kinematics::Joints;
+use edmp_core::robot::{JOINTS, PANDA};
 use serde_json::{Value, json};
 use std::time::Instant;
 
@@ -36,7 +36,8 @@ pub fn plan_document(
         cylinder: config.cylinder,
         frame: config.frame,
     };
-    let intersection = trajectory_cost(&problem.scene(), best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
+    let intersection =
+        trajectory_cost(&PANDA, &problem.scene(), best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
     let per_guide = ROWS / guides.len();
     let guide_of = |row: usize| guides[row / per_guide].id;
     let status = if plan.is_free() { "success" } else { "collision" };

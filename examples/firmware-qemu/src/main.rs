@@ -32,7 +32,7 @@ use edmp_core::planner::{Request, Plan, PlanConfig, Workspace, plan};
 use edmp_core::prior::{STEPS, Scratch, TimeEmbedding, initial_noise, predict_noise};
 use edmp_core::path::{HORIZON, Path};
 use edmp_core::rng::Rng;
-use edmp_core::robot::JOINTS;
+use edmp_core::robot::{JOINTS, PANDA};
 use edmp_core::scene::{Scene, SceneError};
 use edmp_core::surface::bvh::nodes_for;
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
@@ -303,7 +303,7 @@ fn plan_scene(
 ) -> Result<Summary, Failure> {
     let (problem, scene) = decode(bytes, surface)?;
     let mut rng = Rng::new(problem.seed);
-    let plan: Plan<ROWS> = plan::<ROWS, OBSTACLES, 1, { edmp_core::planner::DEFAULT_SEARCH_NODES }>(&Request { scene: &scene, start: &problem.start, goal: &problem.goal, guides: &EDMP_GUIDES, config: &PlanConfig::DEFAULT }, &mut rng, scratch, work)
+    let plan: Plan<ROWS> = plan::<ROWS, OBSTACLES, 1, { edmp_core::planner::DEFAULT_SEARCH_NODES }, JOINTS>(&Request { robot: &PANDA, network: edmp_core::prior::PANDA, scene: &scene, start: &problem.start, goal: &problem.goal, guides: &EDMP_GUIDES, config: &PlanConfig::DEFAULT }, &mut rng, scratch, work)
     .map_err(Failure::Plan)?;
     let path = plan.paths.get(plan.best).copied().unwrap_or([[0.0; JOINTS]; HORIZON]);
     Ok(Summary {
