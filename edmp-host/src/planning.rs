@@ -9,9 +9,9 @@ use crate::threads::Threads;
 use edmp_core::executor::{Executor, Serial};
 use edmp_core::guidance::guides::{EDMP_GUIDES, Guide};
 use edmp_core::planner::{Observer, Phase, Plan, PlanConfig, Request, Workspace, plan_observed};
-use edmp_core::prior::Scratch;
+use edmp_core::prior::{Network, Scratch};
 use edmp_core::rng::Rng;
-use edmp_core::robot::PANDA;
+use edmp_core::robot::JOINTS;
 use std::time::Instant;
 
 /// Rows of the batch: EDMP's 12 guides, one trajectory each.
@@ -21,11 +21,11 @@ pub const ROWS: usize = 12;
 /// them, `--search-nodes` fewer; the firmware and `edmp-host embed` hold 512).
 pub const HOST_SEARCH_NODES: usize = 4096;
 
-/// A planned problem and where the time went.
+/// A planned problem for an arm of `J` joints and where the time went.
 #[derive(Debug)]
-pub struct Planned {
+pub struct Planned<const J: usize = JOINTS> {
     /// Candidates, verdicts, the winner.
-    pub plan: Plan<ROWS>,
+    pub plan: Plan<ROWS, J>,
     /// Milliseconds in IK.
     pub ik_ms: f64,
     /// Milliseconds in the guided denoising.
@@ -38,52 +38,61 @@ pub struct Planned {
     pub shortcut_ms: f64,
 }
 
-impl Planned {
+impl<const J: usize> Planned<J> {
     /// Planning time in all, milliseconds.
     pub fn total_ms(&self) -> f64 {
         self.ik_ms + self.denoise_ms + self.select_ms + self.global_ms + self.shortcut_ms
     }
 }
 
-/// Plans a parsed problem: IK for a pose goal, then the core planner with `ROWS` rows.
-pub fn plan_problem(problem: &Problem, guides: &[Guide], config: &PlanConfig, seed: u64) -> Result<Planned, Failure> {
-    plan_problem_on(problem, guides, config, seed, 1)
+/// Plans a parsed problem with its arm's prior `network`: IK for a pose goal, then the core
+/// planner with `ROWS` rows.
+pub fn plan_problem<const J: usize>(
+    network: &'static Network<J>,
+    problem: &Problem<J>,
+    guides: &[Guide],
+    config: &PlanConfig,
+    seed: u64,
+) -> Result<Planned<J>, Failure> {
+    plan_problem_on(network, problem, guides, config, seed, 1)
 }
 
 /// [`plan_problem`] on `threads` threads (1: on the calling thread): the same plan, bit for bit.
-pub fn plan_problem_on(
-    problem: &Problem,
+pub fn plan_problem_on<const J: usize>(
+    network: &'static Network<J>,
+    problem: &Problem<J>,
     guides: &[Guide],
     config: &PlanConfig,
     seed: u64,
     threads: usize,
-) -> Result<Planned, Failure> {
+) -> Result<Planned<J>, Failure> {
     if threads <= 1 {
         // Four trajectories per network pass share each weight tile.
         let mut scratches = vec![Scratch::<4>::new()];
-        return plan_with(&Serial, problem, guides, config, seed, &mut scratches);
+        return plan_with(&Serial, network, problem, guides, config, seed, &mut scratches);
     }
     let exec = Threads::new(threads).map_err(Failure::Input)?;
     // Three per pass: the 12 rows split evenly over 2, 4 (or 3) threads.
     let mut scratches: Vec<Scratch<3>> = (0..threads.min(ROWS)).map(|_| Scratch::new()).collect();
-    plan_with(&exec, problem, guides, config, seed, &mut scratches)
+    plan_with(&exec, network, problem, guides, config, seed, &mut scratches)
 }
 
-fn plan_with<E: Executor, const C: usize>(
+fn plan_with<E: Executor, const C: usize, const J: usize>(
     exec: &E,
-    problem: &Problem,
+    network: &'static Network<J>,
+    problem: &Problem<J>,
     guides: &[Guide],
     config: &PlanConfig,
     seed: u64,
     scratches: &mut [Scratch<C>],
-) -> Result<Planned, Failure> {
+) -> Result<Planned<J>, Failure> {
     let ik_began = Instant::now();
     let goal = joint_goal(problem).map_err(Failure::Input)?;
     let ik_ms = ik_began.elapsed().as_secs_f64() * 1e3;
-    let mut work = Box::new(Workspace::<ROWS, HOST_SEARCH_NODES>::new());
+    let mut work = Box::new(Workspace::<ROWS, HOST_SEARCH_NODES, J>::new());
     let req = Request {
-        robot: &PANDA,
-        network: edmp_core::prior::PANDA,
+        robot: problem.robot,
+        network,
         scene: &problem.scene(),
         start: &problem.start,
         goal: &goal,

@@ -101,7 +101,7 @@ fn the_table_scene_with_a_joint_goal_is_the_wall_example() {
     assert!(matches!(problem.goal, Goal::Joints(_)));
 
     let guides = chosen_guides(&[]).unwrap();
-    let planned = plan_problem(&problem, &guides, &PlanConfig::DEFAULT, 0).unwrap();
+    let planned = plan_problem(edmp_core::prior::PANDA, &problem, &guides, &PlanConfig::DEFAULT, 0).unwrap();
     assert!(planned.plan.is_free());
     let report = check_trajectory(
         &edmp_core::robot::PANDA,
@@ -724,8 +724,8 @@ fn every_example_round_trips_through_moveit_yaml_and_plans_the_same() {
         }
         // Same problem, same seed: the same plan, and our checker's verdict on it.
         let direct = parse_problem(&original.to_string()).unwrap();
-        let want = plan_problem(&direct, &guides, &PlanConfig::DEFAULT, 3).unwrap();
-        let got = plan_problem(&problem, &guides, &PlanConfig::DEFAULT, 3).unwrap();
+        let want = plan_problem(edmp_core::prior::PANDA, &direct, &guides, &PlanConfig::DEFAULT, 3).unwrap();
+        let got = plan_problem(edmp_core::prior::PANDA, &problem, &guides, &PlanConfig::DEFAULT, 3).unwrap();
         assert_eq!(
             got.plan.paths[got.plan.best], want.plan.paths[want.plan.best],
             "{name}: the imported scene plans differently"

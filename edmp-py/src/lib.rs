@@ -100,7 +100,7 @@ fn plan(
             waves: if candidates { 1 } else { PlanConfig::DEFAULT.waves },
             ..PlanConfig::DEFAULT
         };
-        let planned = plan_problem(&problem, &guides, &config, seed)?;
+        let planned = plan_problem(edmp_core::prior::PANDA, &problem, &guides, &config, seed)?;
         let total_ms = began.elapsed().as_secs_f64() * 1e3;
         let mut doc = plan_document(&problem, &planned, &guides, &config, seed, candidates, total_ms)?;
         if let Some(request) = &request {
@@ -122,7 +122,7 @@ fn plan_problem_ms(py: Python<'_>, scene: &str, seed: u64, repeats: u32) -> PyRe
         (0..repeats)
             .map(|_| {
                 let began = Instant::now();
-                plan_problem(&problem, &guides, &PlanConfig::DEFAULT, seed)?;
+                plan_problem(edmp_core::prior::PANDA, &problem, &guides, &PlanConfig::DEFAULT, seed)?;
                 Ok(began.elapsed().as_secs_f64() * 1e3)
             })
             .collect::<Result<Vec<f64>, Failure>>()
@@ -183,7 +183,7 @@ fn check(scene: &str, waypoints: Vec<Vec<f64>>) -> PyResult<String> {
     )
     .map_err(|e| PlanError::new_err(format!("checker: {e}")))?;
     let first = report.first_contact.map(
-        |c| json!({"segment": c.segment, "step": c.step, "contact": describe(c.contact, &problem.primitive_index)}),
+        |c| json!({"segment": c.segment, "step": c.step, "contact": describe(problem.robot, c.contact, &problem.primitive_index)}),
     );
     to_json(&json!({
         "free": report.is_free(),

@@ -182,7 +182,7 @@ fn held_pair<const J: usize>(robot: &Robot<f32, J>, b: usize) -> bool {
 /// Whether shape `body` (a robot body, or the held object after them) moves with the joints:
 /// bodies with no actuated joint between them and the root (the Panda's link0, the xArm's
 /// `link_base` under its `world` link) are bolted to the mount.
-pub(crate) fn moves<const J: usize>(robot: &Robot<f32, J>, body: usize) -> bool {
+pub fn moves<const J: usize>(robot: &Robot<f32, J>, body: usize) -> bool {
     robot.bodies.get(body).is_none_or(|b| level(robot, b.frame) > 0)
 }
 

@@ -4,8 +4,8 @@
 use crate::collision::convex::{Convex, Hull};
 use crate::collision::gjk::distance_lower_bound;
 use crate::error::Error;
-use crate::robot::kinematics::{Joints, forward_with};
-use crate::robot::{BODIES, FRAMES, PANDA};
+use crate::robot::kinematics::forward_with;
+use crate::robot::{MAX_BODIES, MAX_FRAMES, Robot};
 use nalgebra::Vector3;
 
 /// A point, as a convex set.
@@ -17,21 +17,30 @@ impl Convex for Point {
     }
 }
 
-/// Drops the points within `distance` of the robot's collision bodies (link0 included) at
-/// configuration `q` with the fingers at `finger`; the kept points move to the front. Returns
-/// how many were kept.
-pub fn filter_robot(points: &mut [[f32; 3]], q: &Joints<f32>, finger: f32, distance: f32) -> Result<usize, Error> {
+/// Drops the points within `distance` of the arm's collision bodies (its base included) at
+/// configuration `q` with the fingers at `finger` (the scene's opening; ignored by an arm
+/// without fingers); the kept points move to the front. Returns how many were kept.
+pub fn filter_robot<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    points: &mut [[f32; 3]],
+    q: &[f32; J],
+    finger: f32,
+    distance: f32,
+) -> Result<usize, Error> {
     if !(distance.is_finite() && distance >= 0.0) {
         return Err(Error::BadParameter);
     }
-    let k = forward_with(&PANDA, q, finger)?;
-    let bodies: [(Vector3<f32>, f32); BODIES] = core::array::from_fn(|b| {
-        let body = &PANDA.bodies[b];
-        (
+    let k = forward_with(robot, q, robot.finger_opening(finger))?;
+    let count = robot.bodies.len().min(MAX_BODIES);
+    // Each body's bounding ball: centre and radius.
+    let balls: [(Vector3<f32>, f32); MAX_BODIES] = core::array::from_fn(|b| match robot.bodies.get(b) {
+        Some(body) => (
             k.boxes[b].translation,
             crate::float::sqrt(body.half_extents.norm_squared()),
-        )
+        ),
+        None => (Vector3::zeros(), 0.0),
     });
+    let bodies = &balls[..count];
     let mut kept = 0;
     for i in 0..points.len() {
         let Some(&p) = points.get(i) else { break };
@@ -41,8 +50,8 @@ pub fn filter_robot(points: &mut [[f32; 3]], q: &Joints<f32>, finger: f32, dista
                 return false;
             }
             let hull = Hull {
-                pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
-                points: PANDA.hull(b),
+                pose: &k.frames[robot.bodies[b].frame.min(MAX_FRAMES - 1)],
+                points: robot.hull(b),
             };
             distance_lower_bound(&hull, &Point(v)) <= distance
         });
@@ -68,8 +77,11 @@ mod tests {
         // One point at the hand's origin (on the robot), one 1 m away.
         let hand = k.frames[crate::robot::HAND_FRAME].translation;
         let mut points = [[hand.x, hand.y, hand.z], [tcp.x + 1.0, tcp.y, tcp.z]];
-        assert_eq!(filter_robot(&mut points, &ready, 0.025, 0.01).unwrap(), 1);
+        assert_eq!(
+            filter_robot(&crate::robot::PANDA, &mut points, &ready, 0.025, 0.01).unwrap(),
+            1
+        );
         assert_eq!(points[0], [tcp.x + 1.0, tcp.y, tcp.z]);
-        assert!(filter_robot(&mut points, &ready, 0.025, f32::NAN).is_err());
+        assert!(filter_robot(&crate::robot::PANDA, &mut points, &ready, 0.025, f32::NAN).is_err());
     }
 }

@@ -166,7 +166,14 @@ fn run_edmp(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record
     let read_ms = reading.elapsed().as_secs_f64() * 1e3;
     let guides = args.tuning.guides(&args.guides)?;
     let config = args.tuning.config()?;
-    let planned = plan_problem_on(&parsed, &guides, &config, args.seed, args.tuning.threads()?)?;
+    let planned = plan_problem_on(
+        edmp_core::prior::PANDA,
+        &parsed,
+        &guides,
+        &config,
+        args.seed,
+        args.tuning.threads()?,
+    )?;
     let plan = &planned.plan;
     let per_guide = plan.paths.len() / guides.len();
     // A wave's rows are made together and a later wave runs only after an earlier one found

@@ -4,10 +4,11 @@
 //! nothing written.
 
 use crate::Failure;
-use crate::formats::json::parse_problem_in;
+use crate::formats::json::{parse_problem_for, scene_arm};
 use crate::formats::plan::{add_trajectory, plan_document};
 use crate::formats::trajectory::TimedArgs;
 use crate::planning::{chosen_guides, plan_problem_on};
+use crate::with_arm;
 use edmp_core::cost::boxes::BoxFrame;
 use edmp_core::guidance::guides::{CLEARANCE_GUIDE, Guide, Schedule};
 use edmp_core::planner::GlobalConfig;
@@ -16,7 +17,8 @@ use edmp_core::planner::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Judging,
     PlanConfig, RefineStop,
 };
-use edmp_core::prior::Sampler;
+use edmp_core::prior::{Network, Sampler};
+use edmp_core::robot::Robot;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -376,13 +378,30 @@ impl Tuning {
     }
 }
 
-/// Plans and writes the plan.
+/// Plans for the arm the scene names (`robot`) and writes the plan.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let began = Instant::now();
     let text =
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let in_file = |e: String| Failure::Input(format!("{}: {e}", args.scene.display()));
+    let arm = scene_arm(&text).map_err(|e| in_file(e.to_string()))?;
+    // `with_arm!` returns the error of an arm without a trained prior from this closure.
+    let planned = || -> Result<Result<(), Failure>, String> {
+        Ok(with_arm!(arm, robot, network => plan_for(args, began, &text, robot, network)))
+    };
+    planned().map_err(in_file)?
+}
+
+fn plan_for<const J: usize>(
+    args: &Args,
+    began: Instant,
+    text: &str,
+    robot: &'static Robot<f32, J>,
+    network: &'static Network<J>,
+) -> Result<(), Failure> {
     let dir = args.scene.parent().unwrap_or(std::path::Path::new("."));
-    let problem = parse_problem_in(&text, dir).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let problem =
+        parse_problem_for(text, dir, robot).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let guides = args.tuning.guides(&args.guides)?;
     let mut config = args.tuning.config()?;
     if args.candidates {
@@ -393,7 +412,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     }
     let timed = args.timed.request()?;
 
-    let planned = plan_problem_on(&problem, &guides, &config, args.seed, args.tuning.threads()?)?;
+    let planned = plan_problem_on(network, &problem, &guides, &config, args.seed, args.tuning.threads()?)?;
     let total_ms = began.elapsed().as_secs_f64() * 1e3;
     let mut out = plan_document(
         &problem,

@@ -9,16 +9,16 @@ use crate::arm::Arm;
 use edmp_core::collision::checker::{CheckConfig, Contact, check_end};
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
-use edmp_core::robot::{BODY_NAMES, FINGER_OPENING_MAX, FINGER_OPENING_MIN, JOINT_NAMES, JOINTS, PANDA};
+use edmp_core::robot::{FINGER_OPENING_MAX, FINGER_OPENING_MIN, JOINTS, PANDA, Robot};
 use edmp_core::scene::{MAX_OBSTACLES, Primitive, Scene, SceneError, rotation_from_wxyz};
 use serde_json::{Value, json};
 use std::path::Path;
 
-/// The goal of a problem.
+/// The goal of a problem for an arm of `J` joints.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Goal {
+pub enum Goal<const J: usize = JOINTS> {
     /// A joint configuration.
-    Joints(Joints<f32>),
+    Joints(Joints<f32, J>),
     /// A TCP pose: position and quaternion `[w, x, y, z]`.
     Pose {
         /// TCP position in the world, metres.
@@ -28,9 +28,11 @@ pub enum Goal {
     },
 }
 
-/// A parsed, validated problem.
+/// A parsed, validated problem for an arm of `J` joints (the Panda's by default).
 #[derive(Clone, Debug)]
-pub struct Problem {
+pub struct Problem<const J: usize = JOINTS> {
+    /// The arm the scene names (`robot`).
+    pub robot: &'static Robot<f32, J>,
     /// The primitive obstacles, the held object and the finger opening (`gripper.finger`);
     /// [`Problem::scene`] adds the clouds and meshes.
     primitive_scene: Scene<'static, MAX_OBSTACLES>,
@@ -44,9 +46,9 @@ pub struct Problem {
     /// The held object's parameters, if any.
     pub held: Option<Primitive>,
     /// The start configuration.
-    pub start: Joints<f32>,
+    pub start: Joints<f32, J>,
     /// The goal: joints or a TCP pose.
-    pub goal: Goal,
+    pub goal: Goal<J>,
 }
 
 /// An `edmp-scene/1` primitive (an obstacle or the held object) at `path`: its parameters as
@@ -138,21 +140,21 @@ fn scene_error(e: SceneError, path: &str, size_field: &str) -> InputError {
     }
 }
 
-fn joints(v: &Value, path: &str) -> Result<Joints<f32>, InputError> {
-    let q = numbers::<JOINTS>(v, path)?;
+fn joints<const J: usize>(robot: &Robot<f32, J>, v: &Value, path: &str) -> Result<Joints<f32, J>, InputError> {
+    let q = numbers::<J>(v, path)?;
     for (j, &x) in q.iter().enumerate() {
-        let (lo, hi) = (PANDA.soft_lower[j], PANDA.soft_upper[j]);
+        let (lo, hi) = (robot.soft_lower[j], robot.soft_upper[j]);
         if x < lo - 1e-5 || x > hi + 1e-5 {
             return Err(InputError::at(
                 &format!("{path}[{j}]"),
-                format!("{x} outside {}'s limits [{lo}, {hi}]", JOINT_NAMES[j]),
+                format!("{x} outside {}'s limits [{lo}, {hi}]", robot.joint_names[j]),
             ));
         }
     }
     Ok(q)
 }
 
-impl Problem {
+impl<const J: usize> Problem<J> {
     /// The scene to plan in: the primitives, and the clouds and meshes with their boxes.
     pub fn scene(&self) -> Scene<'_, MAX_OBSTACLES> {
         with_surfaces(&self.primitive_scene, &self.surfaces)
@@ -166,10 +168,10 @@ fn with_surfaces<'a>(primitives: &Scene<'static, MAX_OBSTACLES>, surfaces: &'a S
     primitives.clone().with_surface(surfaces.surface(), &surfaces.boxes)
 }
 
-/// A contact in words, obstacles named by their index in the file (`primitive_index` maps the
-/// scene's primitives to it).
-pub fn describe(contact: Contact, primitive_index: &[usize]) -> String {
-    let body = |b: u8| BODY_NAMES.get(usize::from(b)).copied().unwrap_or("held_object");
+/// A contact of `robot`'s bodies in words, obstacles named by their index in the file
+/// (`primitive_index` maps the scene's primitives to it).
+pub fn describe<const J: usize>(robot: &Robot<f32, J>, contact: Contact, primitive_index: &[usize]) -> String {
+    let body = |b: u8| robot.body_names.get(usize::from(b)).copied().unwrap_or("held_object");
     match contact {
         Contact::Obstacle { body: b, obstacle } => {
             let i = primitive_index
@@ -185,7 +187,7 @@ pub fn describe(contact: Contact, primitive_index: &[usize]) -> String {
 
 /// The problem's goal as joints: itself for a joint goal, the core IK's collision-free solution
 /// nearest the start for a pose goal. The error names the field.
-pub fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
+pub fn joint_goal<const J: usize>(problem: &Problem<J>) -> Result<Joints<f32, J>, String> {
     match problem.goal {
         Goal::Joints(q) => Ok(q),
         Goal::Pose { position, quaternion } => {
@@ -195,7 +197,7 @@ pub fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
                 translation: position.into(),
             };
             solve(
-                &edmp_core::robot::PANDA,
+                problem.robot,
                 &target,
                 &problem.start,
                 &problem.scene(),
@@ -207,48 +209,57 @@ pub fn joint_goal(problem: &Problem) -> Result<Joints<f32>, String> {
     }
 }
 
-/// Parses and validates an `edmp-scene/1` document whose files (clouds, meshes) lie relative
-/// to the current directory.
+/// Parses and validates a Panda's `edmp-scene/1` document whose files (clouds, meshes) lie
+/// relative to the current directory.
 pub fn parse_problem(text: &str) -> Result<Problem, InputError> {
     parse_problem_in(text, Path::new("."))
 }
 
-/// Reads and validates the `edmp-scene/1` file at `path`: files it names lie relative to its
-/// folder. The error names the file.
+/// Reads and validates the Panda's `edmp-scene/1` file at `path`: files it names lie relative
+/// to its folder. The error names the file.
 pub fn read_problem(path: &Path) -> Result<Problem, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     let dir = path.parent().unwrap_or(Path::new("."));
     parse_problem_in(&text, dir).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// The scene's `robot` (absent: the Panda). The host knows the iiwa 7 and the xArm 6 (their
-/// kinematics, `edmp-host fk --robot`, and the exact checker), but plans for the Panda only:
-/// a scene for another arm is refused by name, never planned as if it were a Panda's.
-fn read_robot(value: Option<&Value>) -> Result<Arm, InputError> {
-    let Some(value) = value else { return Ok(Arm::Panda) };
+/// Parses and validates a Panda's `edmp-scene/1` document; files it names lie relative to
+/// `dir`. A scene for another arm is refused by name (commands that take every arm read
+/// [`scene_arm`] first, then [`parse_problem_for`]).
+pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
+    parse_problem_for(text, dir, &PANDA)
+}
+
+/// The arm an `edmp-scene/1` document names in `robot` (absent: the Panda).
+pub fn scene_arm(text: &str) -> Result<Arm, InputError> {
+    read_arm(&parse_json(text)?)
+}
+
+fn parse_json(text: &str) -> Result<Value, InputError> {
+    serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))
+}
+
+fn read_arm(root: &Value) -> Result<Arm, InputError> {
+    let Some(value) = root.get("robot") else {
+        return Ok(Arm::Panda);
+    };
     let known = || Arm::ALL.map(Arm::name).join(", ");
     let name = value
         .as_str()
         .ok_or_else(|| InputError::at("robot", format!("expected a string, one of: {}", known())))?;
-    match Arm::from_name(name) {
-        Some(Arm::Panda) => Ok(Arm::Panda),
-        Some(arm) => Err(InputError::at(
-            "robot",
-            format!(
-                "\"{arm}\": planning for this arm is not built yet (its kinematics are: `edmp-host fk --robot {arm}`); \
-                 the planner runs \"panda\""
-            ),
-        )),
-        None => Err(InputError::at(
-            "robot",
-            format!("unknown arm {value}, expected one of: {}", known()),
-        )),
-    }
+    Arm::from_name(name)
+        .ok_or_else(|| InputError::at("robot", format!("unknown arm {value}, expected one of: {}", known())))
 }
 
-/// Parses and validates an `edmp-scene/1` document; files it names lie relative to `dir`.
-pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
-    let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
+/// Parses and validates an `edmp-scene/1` document for `robot`; files it names lie relative
+/// to `dir`. A document naming another arm is refused by name, never read as if it were
+/// `robot`'s.
+pub fn parse_problem_for<const J: usize>(
+    text: &str,
+    dir: &Path,
+    robot: &'static Robot<f32, J>,
+) -> Result<Problem<J>, InputError> {
+    let root = parse_json(text)?;
     // `meta` (optional, free-form provenance such as the family, seed and the TCP pose of a
     // joint goal) is an extension of the format; the planner ignores it.
     let map = object(
@@ -276,7 +287,16 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
             format!("expected \"edmp-scene/1\", found {format}"),
         ));
     }
-    read_robot(map.get("robot"))?;
+    let arm = read_arm(&root)?;
+    if arm.name() != robot.name {
+        return Err(InputError::at(
+            "robot",
+            format!(
+                "\"{arm}\": this command runs the {} only (`edmp-host plan` and `edmp-host fk --robot` take every arm)",
+                robot.name
+            ),
+        ));
+    }
     let (obstacles, op) = field(map, "", "obstacles")?;
     let list = obstacles
         .as_array()
@@ -327,23 +347,23 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
         })?;
     }
     let (start, sp) = field(map, "", "start")?;
-    let start = joints(start, &sp)?;
+    let start = joints(robot, start, &sp)?;
     // After the start is known: `filter_robot` drops the points the robot has there.
-    let surfaces = build_surfaces(surface_obstacles, &start, scene.gripper())?;
+    let surfaces = build_surfaces(surface_obstacles, robot, &start, scene.gripper())?;
     let primitive_scene = scene;
     let scene = with_surfaces(&primitive_scene, &surfaces);
-    if let Some((body, i)) = inside_closed_mesh(&surfaces, &start, scene.gripper()) {
+    if let Some((body, i)) = inside_closed_mesh(robot, &surfaces, &start, scene.gripper()) {
         return Err(InputError::at(
             &sp,
             format!("in collision: {body} inside the closed mesh obstacles[{i}]"),
         ));
     }
-    if let Some(c) = check_end(&edmp_core::robot::PANDA, &scene, &start, &CheckConfig::default())
-        .map_err(|e| InputError::at(&sp, e.to_string()))?
+    if let Some(c) =
+        check_end(robot, &scene, &start, &CheckConfig::default()).map_err(|e| InputError::at(&sp, e.to_string()))?
     {
         return Err(InputError::at(
             &sp,
-            format!("in collision: {}", describe(c, &primitive_index)),
+            format!("in collision: {}", describe(robot, c, &primitive_index)),
         ));
     }
     let (goal, gp) = field(map, "", "goal")?;
@@ -351,19 +371,19 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
     let goal = match (goal_map.get("joints"), goal_map.get("pose")) {
         (Some(q), None) => {
             let path = format!("{gp}.joints");
-            let q = joints(q, &path)?;
-            if let Some((body, i)) = inside_closed_mesh(&surfaces, &q, scene.gripper()) {
+            let q = joints(robot, q, &path)?;
+            if let Some((body, i)) = inside_closed_mesh(robot, &surfaces, &q, scene.gripper()) {
                 return Err(InputError::at(
                     &path,
                     format!("in collision: {body} inside the closed mesh obstacles[{i}]"),
                 ));
             }
-            if let Some(c) = check_end(&edmp_core::robot::PANDA, &scene, &q, &CheckConfig::default())
+            if let Some(c) = check_end(robot, &scene, &q, &CheckConfig::default())
                 .map_err(|e| InputError::at(&path, e.to_string()))?
             {
                 return Err(InputError::at(
                     &path,
-                    format!("in collision: {}", describe(c, &primitive_index)),
+                    format!("in collision: {}", describe(robot, c, &primitive_index)),
                 ));
             }
             Goal::Joints(q)
@@ -382,6 +402,7 @@ pub fn parse_problem_in(text: &str, dir: &Path) -> Result<Problem, InputError> {
     };
     drop(scene);
     Ok(Problem {
+        robot,
         primitive_scene,
         surfaces,
         primitives,
@@ -421,7 +442,7 @@ mod tests {
     }
 
     #[test]
-    fn the_robot_field_names_the_panda_or_is_refused_by_name() {
+    fn the_robot_field_names_the_arm_and_the_panda_reader_refuses_another() {
         let with = |robot: &str| {
             GOOD.replace(
                 r#""format": "edmp-scene/1","#,
@@ -429,12 +450,39 @@ mod tests {
             )
         };
         assert!(parse_problem(&with(r#""panda""#)).is_ok());
-        assert!(error_of(&with(r#""iiwa7""#)).starts_with("robot: \"iiwa7\": planning for this arm is not built yet"));
+        assert_eq!(scene_arm(&with(r#""iiwa7""#)).ok(), Some(Arm::Iiwa7));
+        assert_eq!(scene_arm(GOOD).ok(), Some(Arm::Panda));
+        assert!(error_of(&with(r#""iiwa7""#)).starts_with("robot: \"iiwa7\": this command runs the panda only"));
         assert_eq!(
             error_of(&with(r#""ur5""#)),
             "robot: unknown arm \"ur5\", expected one of: panda, iiwa7, xarm6"
         );
         assert!(error_of(&with("7")).starts_with("robot: expected a string"));
+    }
+
+    #[test]
+    fn another_arms_scene_has_its_joint_count_and_limits() {
+        let xarm = &edmp_core::robot::arms::xarm6::ROBOT;
+        let scene = |start: &str| {
+            format!(
+                r#"{{"format": "edmp-scene/1", "robot": "xarm6", "obstacles": [],
+                    "start": {start}, "goal": {{"joints": [0.5, -0.5, -0.8, 0, 1.3, 0]}}}}"#
+            )
+        };
+        let error = |text: &str| parse_problem_for(text, Path::new("."), xarm).unwrap_err().to_string();
+        let p = parse_problem_for(&scene("[0, -0.5, -0.8, 0, 1.3, 0]"), Path::new("."), xarm).unwrap();
+        assert_eq!(p.robot.name, "xarm6");
+        assert_eq!(p.start, [0.0, -0.5, -0.8, 0.0, 1.3, 0.0]);
+        assert_eq!(
+            error(&scene("[0, -0.5, -0.8, 0, 1.3, 0, 0]")),
+            "start: expected 6 numbers, found 7"
+        );
+        assert!(error(&scene("[0, -0.5, -0.8, 0, 9, 0]")).starts_with("start[4]: 9 outside joint5's limits"));
+        // A 6-joint scene is no Panda's: refused by name, not by its joint count.
+        assert!(
+            error_of(&scene("[0, -0.5, -0.8, 0, 1.3, 0]"))
+                .starts_with("robot: \"xarm6\": this command runs the panda only")
+        );
     }
 
     #[test]

@@ -11,6 +11,7 @@ use crate::planning::{Planned, ROWS};
 use edmp_core::cost::boxes::Inflation;
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::guidance::guides::Guide;
+use edmp_core::path::Path;
 use edmp_core::planner::{Plan, PlanConfig};
 use edmp_core::robot::kinematics::Joints;
 use edmp_core::robot::{JOINTS, PANDA};
@@ -19,9 +20,9 @@ use std::time::Instant;
 
 /// The `edmp-plan/1` document of a planned problem (docs/formats.md): the one writer of the
 /// format, which the CLI and the Python package share. `total_ms` is the caller's wall time.
-pub fn plan_document(
-    problem: &Problem,
-    planned: &Planned,
+pub fn plan_document<const J: usize>(
+    problem: &Problem<J>,
+    planned: &Planned<J>,
     guides: &[Guide],
     config: &PlanConfig,
     seed: u64,
@@ -37,7 +38,7 @@ pub fn plan_document(
         frame: config.frame,
     };
     let intersection =
-        trajectory_cost(&PANDA, &problem.scene(), best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
+        trajectory_cost(problem.robot, &problem.scene(), best, &iv, None).map_err(|e| Failure::Input(e.to_string()))?;
     let per_guide = ROWS / guides.len();
     let guide_of = |row: usize| guides[row / per_guide].id;
     let status = if plan.is_free() { "success" } else { "collision" };
@@ -104,19 +105,28 @@ pub fn plan_document(
 }
 
 /// Adds the `trajectory` field (and `timing_ms.trajectory`) to a plan document when the plan
-/// is free; `false` when it collides (a colliding path is not timed).
-pub fn add_trajectory(
+/// is free; `false` when it collides (a colliding path is not timed). The time law knows the
+/// Panda's limits only: another arm's problem is refused by name.
+pub fn add_trajectory<const J: usize>(
     doc: &mut serde_json::Value,
-    problem: &Problem,
-    plan: &Plan<ROWS>,
+    problem: &Problem<J>,
+    plan: &Plan<ROWS, J>,
     config: &PlanConfig,
     request: &TimedRequest,
 ) -> Result<bool, Failure> {
+    if problem.robot.name != PANDA.name || J != JOINTS {
+        return Err(Failure::Input(format!(
+            "--timed: the time law knows the Panda's velocity, acceleration and jerk limits only, not the {}'s",
+            problem.robot.name
+        )));
+    }
     let Some(path) = plan.paths.get(plan.best).filter(|_| plan.is_free()) else {
         return Ok(false);
     };
+    // The Panda's path, row by row (J is the Panda's JOINTS here).
+    let path: Path = core::array::from_fn(|i| core::array::from_fn(|j| path[i].get(j).copied().unwrap_or(0.0)));
     let began = Instant::now();
-    doc["trajectory"] = trajectory_document(&problem.scene(), path, &config.check, request)?;
+    doc["trajectory"] = trajectory_document(&problem.scene(), &path, &config.check, request)?;
     doc["timing_ms"]["trajectory"] = json!(began.elapsed().as_secs_f64() * 1e3);
     Ok(true)
 }

@@ -6,8 +6,10 @@
 use super::fields::{InputError, field, number, numbers, object, quaternion};
 use super::file_error::FileError;
 use super::{cloud, mesh_file};
+use edmp_core::collision::checker::moves;
 use edmp_core::collision::filter::filter_robot;
 use edmp_core::cost::cover::covers;
+use edmp_core::robot::Robot;
 use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::{Obstacle, rotation_from_wxyz};
 use edmp_core::surface::Surface;
@@ -314,12 +316,13 @@ impl Source<'_> {
     }
 }
 
-/// Drops each cloud's robot points at `start` (fingers at `finger`), reduces clouds beyond
+/// Drops each cloud's points on `robot` at `start` (fingers at `finger`), reduces clouds beyond
 /// the capacity left by the meshes, and builds the pieces and their tree. A cloud's balls are
 /// made once, straight into the tree's order (no copy of 200,000 pieces to sort).
-pub fn build_surfaces(
+pub fn build_surfaces<const J: usize>(
     mut obstacles: Vec<SurfaceObstacle>,
-    start: &Joints<f32>,
+    robot: &'static Robot<f32, J>,
+    start: &Joints<f32, J>,
     finger: f32,
 ) -> Result<Surfaces, InputError> {
     let mut points_filtered = 0;
@@ -354,7 +357,7 @@ pub fn build_surfaces(
                 filter_robot: filter,
             } => {
                 if let Some(d) = *filter {
-                    let kept = filter_robot(points, start, finger, d)
+                    let kept = filter_robot(robot, points, start, finger, d)
                         .map_err(|e| InputError::at(&format!("{path}.filter_robot"), e.to_string()))?;
                     points_filtered += points.len() - kept;
                     points.truncate(kept);
@@ -507,10 +510,15 @@ pub fn encloses(vertices: &[[f32; 3]], triangles: &[[u32; 3]], p: &Vector3<f32>)
     crossings % 2 == 1
 }
 
-/// The first robot body (by name) whose box centre lies inside a closed mesh at `q`, and that
-/// mesh's obstacle index: an end there touches no triangle yet is inside the obstacle.
-pub fn inside_closed_mesh(surfaces: &Surfaces, q: &Joints<f32>, finger: f32) -> Option<(&'static str, usize)> {
-    let k = edmp_core::robot::kinematics::forward_with(&edmp_core::robot::PANDA, q, finger).ok()?;
+/// The first body of `robot` (by name) whose box centre lies inside a closed mesh at `q`, and
+/// that mesh's obstacle index: an end there touches no triangle yet is inside the obstacle.
+pub fn inside_closed_mesh<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    surfaces: &Surfaces,
+    q: &Joints<f32, J>,
+    finger: f32,
+) -> Option<(&'static str, usize)> {
+    let k = edmp_core::robot::kinematics::forward_with(robot, q, robot.finger_opening(finger)).ok()?;
     for o in &surfaces.obstacles {
         let SurfaceKind::Mesh { vertices, triangles } = &o.kind else {
             continue;
@@ -518,9 +526,9 @@ pub fn inside_closed_mesh(surfaces: &Surfaces, q: &Joints<f32>, finger: f32) -> 
         if !is_closed(vertices, triangles) {
             continue;
         }
-        for (b, (pose, body)) in k.boxes.iter().zip(edmp_core::robot::PANDA.bodies).enumerate() {
-            if body.frame != 0 && encloses(vertices, triangles, &pose.translation) {
-                return Some((edmp_core::robot::BODY_NAMES[b], o.index));
+        for (b, (pose, name)) in k.boxes.iter().zip(robot.body_names).enumerate() {
+            if moves(robot, b) && encloses(vertices, triangles, &pose.translation) {
+                return Some((name, o.index));
             }
         }
     }
@@ -554,7 +562,7 @@ mod tests {
                 triangles: vec![[0, 1, 2]],
             },
         };
-        let s = build_surfaces(vec![cloud, mesh], &[0.0; 7], 0.025).unwrap();
+        let s = build_surfaces(vec![cloud, mesh], &edmp_core::robot::PANDA, &[0.0; 7], 0.025).unwrap();
         assert!(s.pieces() <= MAX_PIECES && s.pieces() > 1);
         assert!(Surface::new(&s.pieces, &s.nodes).is_ok());
         let [(0, r)] = s.reduced[..] else {
