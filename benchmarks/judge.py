@@ -34,10 +34,28 @@ PCD; OBJ, STL, PLY) are read by the small readers below, relative to the scene's
 physics stepping), followed by `performCollisionDetection`, then the queries.
 The collision check of a plan stops at its first contact.
 
+Other arms (docs/formats.md, "Other arms"): a scene whose top-level `robot` is "iiwa7" or
+"xarm6" ("panda" when absent; anything else is bad input) is judged on that arm, loaded from
+pybullet_data (`kuka_iiwa/model.urdf`, `xarm/xarm6_robot.urdf`) after checking that the URDF and
+every collision mesh it names equal the repository's copies (`weights/iiwa7/`, `weights/xarm6/`)
+byte for byte, with a fixed base at the origin. The same three rules, with: joint vectors of the
+arm's joint count (7, 6) in its URDF's joint order (waypoints of another shape are "malformed";
+a `start` or joint goal of another length is bad input); the limits of its URDF's `<limit>`s; the
+pose goal's TCP the link `lbr_iiwa_link_7` / `link6`; robot bodies every link with collision
+geometry, those with no actuated joint between them and the root (the iiwa's
+`lbr_iiwa_link_0`, the xArm's `link_base` under its geometry-free `world`) not checked against
+obstacles; self pairs the links that are not parent and child and do not touch
+(`getClosestPoints` distance > 0) at the all-zero configuration (tests/fixtures/record_collision.py's
+rule). Neither arm has a hand: `gripper` is ignored; a `held_object` is fixed to the TCP link and
+checked against the links two or more actuated joints below it (as the Panda's against the links
+two or more below its hand). Their verdicts carry `robot`; their table rows read
+`family (arm)` and their listed plans `problem [arm]`. A Panda scene's verdict and rows are as
+before.
+
 Inputs: a problem directory (`<problems>/<family>/<NNN>.json`, `edmp-scene/1`) and either a
 plan directory of the same layout (`<plans>/<family>/<NNN>.json`, `edmp-plan/1`) or a JSONL
 file of results (one JSON object per line: `problem` relative to the problem directory, e.g.
-"cubby/003.json", `status`, `waypoints` (50 x 7; empty, null or absent when the planner gave
+"cubby/003.json", `status`, `waypoints` (50 x the arm's joints; empty, null or absent when the planner gave
 nothing), optional `planner`; other fields are ignored), such as the `results.jsonl` that
 `edmp-host bench --out DIR` writes (`--results DIR` reads DIR/results.jsonl).
 
@@ -75,7 +93,8 @@ import multiprocessing
 import os
 import pathlib
 import sys
-from dataclasses import dataclass
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -126,9 +145,28 @@ LIMITS = [
 HELD = "held_object"
 
 
+@dataclass(frozen=True)
+class Arm:
+    """An arm other than the Panda (docs/formats.md, "Other arms"): pybullet_data's URDF,
+    checked byte for byte against the repository's copy, its joint count and the link a held
+    object is fixed to (its TCP: neither arm has a hand)."""
+
+    packaged: str  # the URDF's path inside pybullet_data
+    urdf: pathlib.Path  # the repository's copy
+    joints: int
+    tcp: str
+
+
+ARMS = {
+    "iiwa7": Arm("kuka_iiwa/model.urdf", ROOT / "weights" / "iiwa7" / "model.urdf", 7, "lbr_iiwa_link_7"),
+    "xarm6": Arm("xarm/xarm6_robot.urdf", ROOT / "weights" / "xarm6" / "xarm6_robot.urdf", 6, "link6"),
+}
+ROBOTS = ("panda", *ARMS)
+
+
 @dataclass
 class Robot:
-    """One PyBullet client with the Panda loaded."""
+    """One PyBullet client with one arm loaded (the Panda unless `arm` says otherwise)."""
 
     client: int
     body: int
@@ -141,6 +179,9 @@ class Robot:
     hand: int
     tcp: int
     finger: float = FINGER_OPENING  # both finger joints, set from each scene's `gripper`
+    arm: str = "panda"  # the scene's `robot`
+    limits: list[tuple[float, float]] = field(default_factory=lambda: list(LIMITS))  # one per revolute joint
+    fixed: list[int] = field(default_factory=lambda: [-1])  # links with geometry bolted to the mount (not checked against obstacles)
 
 
 def level(name: str) -> int:
@@ -151,8 +192,10 @@ def level(name: str) -> int:
     return 7
 
 
-def packaged_urdf() -> pathlib.Path:
-    """pybullet_data's Panda, after checking it is the repository's robot byte for byte."""
+def packaged_urdf(arm: str = "panda") -> pathlib.Path:
+    """pybullet_data's Panda (or other arm), after checking it is the repository's robot byte for byte."""
+    if arm != "panda":
+        return packaged_arm_urdf(ARMS[arm])
     data = pathlib.Path(pybullet_data.getDataPath()) / "franka_panda"
     packaged = data / "panda.urdf"
     if packaged.read_bytes() != URDF.read_bytes():
@@ -164,7 +207,33 @@ def packaged_urdf() -> pathlib.Path:
     return packaged
 
 
-def connect() -> Robot:
+def packaged_arm_urdf(spec: Arm) -> pathlib.Path:
+    """pybullet_data's copy of another arm, after checking that it and every collision mesh its
+    URDF names (`package://X/...` is `<URDF folder>/X/...`) equal the repository's copies."""
+    data = pathlib.Path(pybullet_data.getDataPath())
+    packaged = data / spec.packaged
+    if not packaged.is_file() or packaged.read_bytes() != spec.urdf.read_bytes():
+        raise SystemExit(f"{packaged} differs from {spec.urdf}: the judge would collide another robot")
+    for mesh in ET.parse(spec.urdf).getroot().iter("collision"):
+        for geometry in mesh.iter("mesh"):
+            rel = geometry.get("filename", "").removeprefix("package://")
+            ours, theirs = spec.urdf.parent / rel, packaged.parent / rel
+            if not ours.is_file() or not theirs.is_file() or theirs.read_bytes() != ours.read_bytes():
+                raise SystemExit(f"{theirs} differs from {ours}: the judge would collide another robot")
+    return packaged
+
+
+def scene_robot(scene: dict[str, Any]) -> str:
+    """The scene's `robot` ("panda" when absent); ValueError (bad input) for any other value."""
+    arm = scene.get("robot", "panda")
+    if not isinstance(arm, str) or arm not in ROBOTS:
+        raise ValueError(f"robot: {arm!r} (expected one of: {', '.join(ROBOTS)})")
+    return arm
+
+
+def connect(arm: str = "panda") -> Robot:
+    if arm != "panda":
+        return connect_arm(arm)
     packaged = packaged_urdf()
     client = p.connect(p.DIRECT)
     body = p.loadURDF(str(packaged), basePosition=[0, 0, 0], useFixedBase=True, physicsClientId=client)
@@ -189,6 +258,76 @@ def connect() -> Robot:
         held_partners=held_partners,
         hand=index["panda_hand"],
         tcp=index["panda_grasptarget"],
+    )
+
+
+def urdf_limits(urdf: pathlib.Path, joints: list[str]) -> list[tuple[float, float]]:
+    """The `<limit lower upper>` of each named joint, as the URDF writes them (the robot's own
+    `<joint>`s, not the transmissions' references to them)."""
+    found = {j.get("name"): j.find("limit") for j in ET.parse(urdf).getroot().findall("joint")}
+    return [(float(found[name].get("lower")), float(found[name].get("upper"))) for name in joints]
+
+
+def apart_at_zero(client: int, body: int, parent: dict[int, int], geometry: list[int]) -> list[tuple[int, int]]:
+    """The self pairs of an arm other than the Panda: links with geometry that are not parent
+    and child and do not touch (getClosestPoints distance > 0) at the all-zero configuration."""
+    for j in range(p.getNumJoints(body, physicsClientId=client)):
+        if p.getJointInfo(body, j, physicsClientId=client)[2] != p.JOINT_FIXED:
+            p.resetJointState(body, j, 0.0, physicsClientId=client)
+    p.performCollisionDetection(physicsClientId=client)
+    pairs = []
+    for i, a in enumerate(geometry):
+        for b in geometry[i + 1 :]:
+            if parent.get(a) == b or parent.get(b) == a:
+                continue
+            if closest(client, body, body, 0.0, a, b) is None:
+                pairs.append((a, b))
+    return pairs
+
+
+def connect_arm(arm: str) -> Robot:
+    """The iiwa 7 or the xArm 6 (docs/formats.md, "Other arms"): joint vectors in the URDF's
+    joint order, limits from its `<limit>`s, base at the origin. Robot bodies: every link with
+    collision geometry; those with no actuated joint between them and the root (the base link,
+    the xArm's `link_base` under its geometry-free `world`) are not checked against obstacles.
+    Self pairs: `apart_at_zero`. The held object is fixed to the TCP link and checked against
+    the links two or more actuated joints below it, as the Panda's against those below its hand."""
+    spec = ARMS[arm]
+    packaged = packaged_urdf(arm)
+    client = p.connect(p.DIRECT)
+    body = p.loadURDF(str(packaged), basePosition=[0, 0, 0], useFixedBase=True, physicsClientId=client)
+    n = p.getNumJoints(body, physicsClientId=client)
+    infos = [p.getJointInfo(body, j, physicsClientId=client) for j in range(n)]
+    actuated = [j for j in range(n) if infos[j][2] != p.JOINT_FIXED]
+    revolute = [j for j in actuated if infos[j][2] == p.JOINT_REVOLUTE]
+    assert revolute == actuated and len(revolute) == spec.joints, (arm, actuated, revolute)
+    names = {-1: p.getBodyInfo(body, physicsClientId=client)[0].decode(), **{j: infos[j][12].decode() for j in range(n)}}
+    index = {name: j for j, name in names.items()}
+    parent = {j: infos[j][16] for j in range(n)}
+
+    def joints_below(link: int) -> int:  # actuated joints between the link and the root
+        count = 0
+        while link != -1:
+            count += infos[link][2] != p.JOINT_FIXED
+            link = parent[link]
+        return count
+
+    geometry = [j for j in [-1, *range(n)] if p.getCollisionShapeData(body, j, physicsClientId=client)]
+    tcp = index[spec.tcp]
+    return Robot(
+        client=client,
+        body=body,
+        revolute=revolute,
+        prismatic=[],
+        names=names,
+        moving=[j for j in geometry if joints_below(j) > 0],
+        self_pairs=apart_at_zero(client, body, parent, geometry),
+        held_partners=[j for j in geometry if joints_below(j) <= joints_below(tcp) - 2],
+        hand=tcp,
+        tcp=tcp,
+        arm=arm,
+        limits=urdf_limits(spec.urdf, [infos[j][1].decode() for j in revolute]),
+        fixed=[j for j in geometry if joints_below(j) == 0],
     )
 
 
@@ -416,7 +555,7 @@ def near_robot(robot: Robot, points: np.ndarray, within: float) -> np.ndarray:
     p.performCollisionDetection(physicsClientId=c)
     near = np.zeros(len(points), dtype=bool)
     candidate = np.zeros(len(points), dtype=bool)
-    for link in [-1, *robot.moving]:
+    for link in [*robot.fixed, *robot.moving]:
         lo, hi = (np.asarray(v) for v in p.getAABB(robot.body, link, physicsClientId=c))
         candidate |= np.all((points >= lo - within) & (points <= hi + within), axis=1)
     if not candidate.any():
@@ -466,19 +605,19 @@ class Cloud:
         return self.probes[r]
 
     def _near(self, body: int, at: np.ndarray, within: float, other: int) -> tuple[float, int] | None:
-        """(distance, link) of the nearest link of `other` (the robot: links 1..; or the held
-        object) to the probe, if within."""
+        """(distance, link) of the nearest link of `other` (the robot: its moving links; or the
+        held object) to the probe, if within."""
         c = self.robot.client
         p.resetBasePositionAndOrientation(body, at.tolist(), [0, 0, 0, 1], physicsClientId=c)
         best = None
         for pt in p.getClosestPoints(body, other, within, physicsClientId=c):
-            if (pt[4] != -1 or other != self.robot.body) and pt[8] <= within and (best is None or pt[8] < best[0]):
+            if (pt[4] not in self.robot.fixed or other != self.robot.body) and pt[8] <= within and (best is None or pt[8] < best[0]):
                 best = (pt[8], pt[4])
         return best
 
     def nearest(self, within: float, other: int | None = None) -> tuple[float, int] | None:
-        """(distance, link) of the nearest ball to the robot (links 1..) or to `other` (the
-        held object), if within `within` (0: contact)."""
+        """(distance, link) of the nearest ball to the robot (its moving links) or to `other`
+        (the held object), if within `within` (0: contact)."""
         robot, c = self.robot, self.robot.client
         other = robot.body if other is None else other
         if not len(self.centers):
@@ -660,17 +799,29 @@ def quaternion_angle(q1_xyzw: Any, q2_xyzw: Any) -> float:
 
 def judge(robot: Robot, scene: dict[str, Any], plan: dict[str, Any], base: pathlib.Path | None = None) -> dict[str, Any]:
     """The verdict on one plan: `solved`, the list of `failed` rules and their details.
-    `base`: the scene file's folder, against which obstacle `file`s are read."""
+    `base`: the scene file's folder, against which obstacle `file`s are read. `robot` must be
+    the scene's arm (`connect(scene_robot(scene))`); ValueError otherwise. Verdicts on arms
+    other than the Panda carry `robot`."""
+    arm = scene_robot(scene)
+    if arm != robot.arm:
+        raise ValueError(f"the scene is for the {arm}, the judge's robot is the {robot.arm}")
     verdict: dict[str, Any] = {"solved": False, "failed": []}
-    robot.finger = finger_opening(scene)
+    joints = len(robot.revolute)
+    if arm == "panda":
+        robot.finger = finger_opening(scene)
+    else:  # no hand: `gripper` is ignored
+        verdict["robot"] = arm
+        for name, value in (("start", scene["start"]), ("goal.joints", scene["goal"].get("joints"))):
+            if value is not None and np.shape(value) != (joints,):
+                raise ValueError(f"{name}: expected {joints} numbers (the {arm}'s joints), found {value!r}")
     waypoints = plan.get("waypoints")
     try:
         w = np.asarray(waypoints, dtype=np.float64)
     except (TypeError, ValueError):
         w = np.zeros((0,))
-    if waypoints is None or w.shape != (HORIZON, 7) or not np.all(np.isfinite(w)):
+    if waypoints is None or w.shape != (HORIZON, joints) or not np.all(np.isfinite(w)):
         verdict["failed"] = ["malformed"]
-        verdict["detail"] = "no waypoints" if not waypoints else f"waypoints of shape {w.shape} or not finite, expected {HORIZON}x7"
+        verdict["detail"] = "no waypoints" if not waypoints else f"waypoints of shape {w.shape} or not finite, expected {HORIZON}x{joints}"
         return verdict
     failed = verdict["failed"]
 
@@ -698,7 +849,7 @@ def judge(robot: Robot, scene: dict[str, Any], plan: dict[str, Any], base: pathl
 
     # Rule 2: the joint limits.
     for i, q in enumerate(w):
-        for j, (lo, hi) in enumerate(LIMITS):
+        for j, (lo, hi) in enumerate(robot.limits):
             if not lo - LIMIT_TOLERANCE <= q[j] <= hi + LIMIT_TOLERANCE:
                 verdict["limit_violation"] = {"waypoint": i, "joint": j + 1, "value": float(q[j]), "limits": [lo, hi]}
                 break
@@ -725,7 +876,8 @@ def judge(robot: Robot, scene: dict[str, Any], plan: dict[str, Any], base: pathl
 def walk(robot: Robot, scene: dict[str, Any], w: np.ndarray, query: Any, base: pathlib.Path | None = None, **kwargs: Any) -> Any:
     """Yields (segment, step, steps, query result) at every checked state, the scene's bodies
     spawned for the walk and removed after it, the fingers at the scene's opening."""
-    robot.finger = finger_opening(scene)
+    if robot.arm == "panda":
+        robot.finger = finger_opening(scene)
     spawned = spawn_scene(robot, scene, base)
     obstacles = [b for _, b in spawned]
     held, held_pose = None, None
@@ -760,21 +912,31 @@ def clearance(robot: Robot, scene: dict[str, Any], waypoints: Any, within: float
 
 # ---- the command line ----------------------------------------------------------------------
 
-_ROBOT: Robot | None = None
+_ROBOTS: dict[str, Robot] = {}  # this worker's arms: the Panda from the start, others when a scene names them
 
 
 def _init_worker() -> None:
-    global _ROBOT
-    _ROBOT = connect()
+    _ROBOTS.clear()
+    _ROBOTS["panda"] = connect()
+
+
+def _robot_for(arm: str) -> Robot:
+    if arm not in _ROBOTS:
+        try:
+            _ROBOTS[arm] = connect(arm)
+        except SystemExit as e:  # its URDF differs from the repository's: bad input, not a crash of the pool
+            raise ValueError(str(e)) from None
+    return _ROBOTS[arm]
 
 
 def _judge_job(job: dict[str, Any]) -> dict[str, Any]:
-    assert _ROBOT is not None
+    assert "panda" in _ROBOTS
     scene = json.loads(pathlib.Path(job["problem_path"]).read_text())
     base = pathlib.Path(job["problem_path"]).parent
-    verdict = judge(_ROBOT, scene, {"waypoints": job["waypoints"]}, base)
+    robot = _robot_for(scene_robot(scene))
+    verdict = judge(robot, scene, {"waypoints": job["waypoints"]}, base)
     if is_false_failure(job | verdict):
-        verdict["closest_approach"] = clearance(_ROBOT, scene, job["waypoints"], CLEARANCE_WITHIN, base)
+        verdict["closest_approach"] = clearance(robot, scene, job["waypoints"], CLEARANCE_WITHIN, base)
     return {k: v for k, v in job.items() if k not in ("waypoints", "problem_path")} | verdict
 
 
@@ -824,9 +986,9 @@ def summarize(verdicts: list[dict[str, Any]]) -> tuple[str, int]:
             "|---|---|---|---|---|---|",
         ]
         mine = [v for v in verdicts if v["planner"] == planner]
-        families = sorted({v["family"] for v in mine})
+        families = sorted({row_name(v) for v in mine})
         for family in [*families, None]:
-            rows = [v for v in mine if family is None or v["family"] == family]
+            rows = [v for v in mine if family is None or row_name(v) == family]
             claimed = sum(v["status"] == "success" for v in rows)
             solved = sum(v["solved"] for v in rows)
             false_success = [v for v in rows if v["status"] == "success" and not v["solved"]]
@@ -841,16 +1003,25 @@ def summarize(verdicts: list[dict[str, Any]]) -> tuple[str, int]:
             lines.append("False successes:")
             lines.append("")
             for v in sorted(bad, key=lambda v: v["problem"]):
-                lines.append(f"- {v['problem']}: {describe(v)}")
+                lines.append(f"- {v['problem']}{arm_tag(v)}: {describe(v)}")
             lines.append("")
         missed = [v for v in mine if is_false_failure(v)]
         if missed:
             lines.append(f"False failures (planner said failure, PyBullet finds no contact; closest approach within {CLEARANCE_WITHIN * 1000:.0f} mm):")
             lines.append("")
             for v in sorted(missed, key=lambda v: v["problem"]):
-                lines.append(f"- {v['problem']} ({v['status']}): {describe_near(v.get('closest_approach'))}")
+                lines.append(f"- {v['problem']}{arm_tag(v)} ({v['status']}): {describe_near(v.get('closest_approach'))}")
             lines.append("")
     return "\n".join(lines), false_total
+
+
+def row_name(v: dict[str, Any]) -> str:
+    """A verdict's row in the tables: its family, and the arm when it is not the Panda."""
+    return v["family"] + (f" ({v['robot']})" if v.get("robot", "panda") != "panda" else "")
+
+
+def arm_tag(v: dict[str, Any]) -> str:
+    return f" [{v['robot']}]" if v.get("robot", "panda") != "panda" else ""
 
 
 def is_false_failure(v: dict[str, Any]) -> bool:

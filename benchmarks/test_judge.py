@@ -448,3 +448,306 @@ def test_truth_obstacles_replace_the_scenes_obstacles(robot, tmp_path):
     assert judge.main(["--problems", str(problems), "--results", str(run), "--jobs", "1", "--no-progress"]) == 1
     (problems / "cells" / "000.obj").unlink()
     assert judge.main(["--problems", str(problems), "--results", str(run), "--jobs", "1", "--no-progress"]) == 2
+
+
+# ---- other arms: the iiwa 7 and the xArm 6 (docs/formats.md, "Other arms") -------------------
+
+FIXTURES = HERE.parent / "tests" / "fixtures"
+# The example scenes: a table top and a 50 cm upright cylinder (obstacle 1) between the ends.
+TABLE = {"type": "cuboid", "center": [0.5, 0.0, 0.0], "dims": [0.6, 1.2, 0.02], "quaternion": [1, 0, 0, 0]}
+POST = {"type": "cylinder", "center": [0.35, 0.25, 0.25], "radius": 0.04, "height": 0.5, "quaternion": [1, 0, 0, 0]}
+ARM_ENDS = {
+    "xarm6": ([0, -0.5, -0.8, 0, 1.3, 0], [1.2, -0.3, -0.9, 0, 1.2, 0]),
+    "iiwa7": ([0, 0.2, 0, -2.0, 0, 0.95, 0], [1.2, 0.3, 0, -1.8, 0, 0.95, 0]),
+}
+# A corner the arm swings through on its way: "over" passes the post (PyBullet: 33 mm for the
+# xArm), "through" drives the wrist into it (-42 mm, -72 mm).
+ARM_CORNERS = {
+    "xarm6": {"over": [0.6, -0.6, -0.6, 0, 1.3, 0], "through": [0.6, -0.3, -1.0, 0, 1.3, 0]},
+    "iiwa7": {"over": [0.6, 0.0, 0, -1.6, 0, 0.7, 0], "through": [0.6, 0.2, 0, -2.0, 0, 0.95, 0]},
+}
+ARM_LINKS = {
+    "xarm6": ["link_base", "link1", "link2", "link3", "link4", "link5", "link6"],
+    "iiwa7": [f"lbr_iiwa_link_{k}" for k in range(8)],
+}
+
+
+@pytest.fixture(scope="module")
+def arms() -> dict[str, judge.Robot]:
+    return {arm: judge.connect(arm) for arm in judge.ARMS}
+
+
+def arm_scene(arm: str, start: list[float], goal: list[float], obstacles: list[dict] | None = None) -> dict:
+    return empty_scene(start, goal, obstacles) | {"robot": arm}
+
+
+def polyline(corners: list[list[float]]) -> list[list[float]]:
+    """HORIZON waypoints evenly spaced (in joint space) along the corners, the ends exact."""
+    c = np.asarray(corners, dtype=np.float64)
+    length = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))]
+    out = [np.array([np.interp(t, length, c[:, j]) for j in range(c.shape[1])]) for t in np.linspace(0.0, length[-1], judge.HORIZON)]
+    out[0], out[-1] = c[0], c[-1]
+    return [list(map(float, q)) for q in out]
+
+
+def record_collision():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("record_collision", FIXTURES / "record_collision.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "iiwa7"])
+def test_other_arms_are_pybullet_datas_copies_with_the_urdfs_limits(arms, arm):
+    r = arms[arm]
+    assert judge.packaged_urdf(arm).read_bytes() == judge.ARMS[arm].urdf.read_bytes()
+    assert str(judge.packaged_urdf(arm)).startswith(judge.pybullet_data.getDataPath())
+    assert len(r.revolute) == judge.ARMS[arm].joints == len(ARM_ENDS[arm][0]) and r.prismatic == []
+    names = [r.names[j] for j in [*r.fixed, *r.moving]]
+    assert names == ARM_LINKS[arm]
+    assert [r.names[j] for j in r.fixed] == ARM_LINKS[arm][:1]  # the base link is not checked against obstacles
+    assert r.names[r.tcp] == r.names[r.hand] == ARM_LINKS[arm][-1]
+    if arm == "xarm6":
+        assert r.limits[2] == (-3.927, 0.19198) and r.limits[4] == (-1.69297, 3.14159265359)
+    else:
+        assert r.limits[1] == (-2.09439510239, 2.09439510239) and r.limits[6] == (-3.05432619099, 3.05432619099)
+    # The held object may touch only the links within one actuated joint of the TCP's.
+    assert [r.names[j] for j in r.held_partners] == ARM_LINKS[arm][:-2]
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "iiwa7"])
+def test_other_arms_self_pairs_and_bodies_follow_record_collisions_rule(arms, arm):
+    rc = record_collision()
+    client = judge.p.connect(judge.p.DIRECT)
+    try:
+        body, revolute, limits, names, with_geometry = rc.load_arm(client, rc.ARMS[arm])
+        pairs = [[names[a], names[b]] for a, b in rc.apart_at_zero_pairs(client, body, revolute, with_geometry)]
+    finally:
+        judge.p.disconnect(client)
+    r = arms[arm]
+    mine = [[r.names[a], r.names[b]] for a, b in r.self_pairs]
+    assert mine == pairs
+    assert mine == json.loads((FIXTURES / f"collision_pybullet_{arm}.json").read_text())["self_link_pairs"]
+    assert mine == json.loads((FIXTURES / f"fk_pybullet_{arm}.json").read_text())["self_pairs"]
+    assert r.limits == [tuple(lim) for lim in limits]
+    assert sorted(r.names[j] for j in [*r.fixed, *r.moving]) == sorted(names[j] for j in with_geometry)
+    # Parent and child are never a pair; links two apart are.
+    assert [ARM_LINKS[arm][0], ARM_LINKS[arm][1]] not in mine and [ARM_LINKS[arm][1], ARM_LINKS[arm][3]] in mine
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "iiwa7"])
+def test_other_arms_through_an_obstacle_is_contact_around_it_is_free(arms, arm):
+    start, goal = ARM_ENDS[arm]
+    scene = arm_scene(arm, start, goal, [TABLE, POST])
+    over = polyline([start, ARM_CORNERS[arm]["over"], goal])
+    v = judge.judge(arms[arm], scene, {"waypoints": over})
+    assert v["solved"], v
+    assert v["robot"] == arm and v["states_checked"] > judge.HORIZON
+    v = judge.judge(arms[arm], scene, {"waypoints": polyline([start, ARM_CORNERS[arm]["through"], goal])})
+    assert v["failed"] == ["contact"] and v["robot"] == arm
+    c = v["first_contact"]
+    assert c["kind"] == "obstacle" and c["obstacle"] == 1 and c["distance"] <= 0.0
+    assert c["link"] in ARM_LINKS[arm][1:]
+    # Without the post the same path is free; the Panda's judge refuses the scene.
+    assert judge.judge(arms[arm], arm_scene(arm, start, goal, [TABLE]), {"waypoints": polyline([start, ARM_CORNERS[arm]["through"], goal])})["solved"]
+    with pytest.raises(ValueError):
+        judge.judge(judge.connect(), scene, {"waypoints": over})
+    assert judge.p.getNumBodies(physicsClientId=arms[arm].client) == 1
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "iiwa7"])
+def test_other_arms_obstacle_verdicts_match_the_pybullet_fixture(arms, arm):
+    # tests/fixtures/collision_pybullet_NAME.json: PyBullet's distance from every moving link (the
+    # base not included) to one obstacle. Contact entries a millimetre deep are contact with that
+    # obstacle; free entries a millimetre clear have no obstacle contact (self-contact may remain).
+    fixture = json.loads((FIXTURES / f"collision_pybullet_{arm}.json").read_text())["obstacle_pairs"]
+    deep = [e for e in fixture if e["distance"] < -0.001][:15]
+    clear = [e for e in fixture if e["distance"] > 0.001][:15]
+    base_near = 0
+    for e in deep + clear:
+        v = judge.judge(arms[arm], arm_scene(arm, e["joints"], e["joints"], [e["obstacle"]]), {"waypoints": constant(e["joints"])})
+        c = v.get("first_contact", {})
+        if e["distance"] < 0:
+            assert c.get("kind") == "obstacle" and c["obstacle"] == 0, (e, v)
+        else:
+            assert c.get("kind") != "obstacle", (e, v)
+    # Fixture obstacles that touch only the base link are free: the base is bolted down.
+    r = arms[arm]
+    for e in fixture:
+        if e["distance"] > 0.001:
+            body = judge.spawn(r, e["obstacle"])
+            judge.set_state(r, np.asarray(e["joints"]))
+            judge.p.performCollisionDetection(physicsClientId=r.client)
+            touches_base = any(judge.closest(r.client, r.body, body, 0.0, link) is not None for link in r.fixed)
+            judge.p.removeBody(body, physicsClientId=r.client)
+            if touches_base:
+                base_near += 1
+                v = judge.judge(r, arm_scene(arm, e["joints"], e["joints"], [e["obstacle"]]), {"waypoints": constant(e["joints"])})
+                assert v.get("first_contact", {}).get("kind") != "obstacle", (e, v)
+    assert base_near > 0, "no fixture obstacle touches the base link"
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "iiwa7"])
+def test_other_arms_self_contact_matches_the_pybullet_fixture(arms, arm):
+    fixture = json.loads((FIXTURES / f"collision_pybullet_{arm}.json").read_text())["self_pairs"]
+    deep = [e for e in fixture if e["distance"] < -0.001][:10]
+    clear = [e for e in fixture if e["distance"] > 0.001][:10]
+    assert deep and clear
+    r = arms[arm]
+    pairs = {frozenset((r.names[a], r.names[b])) for a, b in r.self_pairs}
+    for e in deep:
+        v = judge.judge(r, arm_scene(arm, e["joints"], e["joints"]), {"waypoints": constant(e["joints"])})
+        assert v["failed"] == ["contact"], (e, v)
+        c = v["first_contact"]
+        assert c["kind"] == "self" and frozenset((c["link"], c["other"])) in pairs
+    for e in clear:
+        v = judge.judge(r, arm_scene(arm, e["joints"], e["joints"]), {"waypoints": constant(e["joints"])})
+        assert v["solved"], (e, v)
+
+
+def test_other_arms_joint_counts(arms):
+    start, goal = ARM_ENDS["xarm6"]
+    scene = arm_scene("xarm6", start, goal, [TABLE, POST])
+    over = polyline([start, ARM_CORNERS["xarm6"]["over"], goal])
+    seven = [q + [0.0] for q in over]  # a 7-number waypoint for the 6-joint xArm
+    v = judge.judge(arms["xarm6"], scene, {"waypoints": seven})
+    assert v["failed"] == ["malformed"] and "expected 50x6" in v["detail"] and v["robot"] == "xarm6"
+    iiwa_start, iiwa_goal = ARM_ENDS["iiwa7"]
+    six = [q[:6] for q in polyline([iiwa_start, iiwa_goal])]
+    v = judge.judge(arms["iiwa7"], arm_scene("iiwa7", iiwa_start, iiwa_goal), {"waypoints": six})
+    assert v["failed"] == ["malformed"] and "expected 50x7" in v["detail"]
+    # A Panda plan (7 numbers) for the xArm's scene, and ends of the wrong length: bad input.
+    for bad in (arm_scene("xarm6", start + [0.0], goal), arm_scene("xarm6", start, goal[:5])):
+        with pytest.raises(ValueError):
+            judge.judge(arms["xarm6"], bad, {"waypoints": over})
+    for name in ("ur5", "Panda", 7, None):
+        with pytest.raises(ValueError):
+            judge.scene_robot({"robot": name})
+    assert judge.scene_robot({}) == "panda" and judge.scene_robot({"robot": "panda"}) == "panda"
+
+
+def test_other_arms_limits_are_the_urdfs(arms):
+    q = [0.0, -0.5, 0.19198 + 2e-5, 0.0, 1.3, 0.0]  # xArm joint 3's upper limit is 0.19198
+    v = judge.judge(arms["xarm6"], arm_scene("xarm6", q, q), {"waypoints": constant(q)})
+    assert v["limit_violation"]["joint"] == 3 and v["limit_violation"]["limits"] == [-3.927, 0.19198]
+    q[2] = 0.19198 + 5e-6
+    assert "limits" not in judge.judge(arms["xarm6"], arm_scene("xarm6", q, q), {"waypoints": constant(q)})["failed"]
+    # Beyond the Panda's limits, within the iiwa's: joint 4 at +0.5 (the Panda's stays below -0.0698).
+    q = [0.0, 0.3, 0.0, 0.5, 0.0, 0.3, 0.0]
+    assert "limits" not in judge.judge(arms["iiwa7"], arm_scene("iiwa7", q, q), {"waypoints": constant(q)})["failed"]
+    q[6] = -3.05432619099 - 2e-5
+    v = judge.judge(arms["iiwa7"], arm_scene("iiwa7", q, q), {"waypoints": constant(q)})
+    assert v["failed"] == ["limits"] and v["limit_violation"]["joint"] == 7
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "iiwa7"])
+def test_other_arms_pose_goals_are_the_tcp_links(arms, arm):
+    # tests/fixtures/fk_pybullet_NAME.json: the TCP link's world pose (x y z qw qx qy qz) at
+    # random configurations, recorded from the repository's URDF.
+    fk = json.loads((FIXTURES / f"fk_pybullet_{arm}.json").read_text())
+    tcp = fk["links"].index(ARM_LINKS[arm][-1])
+    for sample in fk["samples"][1:6]:
+        q, pose = sample["joints"], sample["poses"][tcp]
+        scene = arm_scene(arm, q, q) | {"goal": {"pose": {"position": pose[:3], "quaternion": pose[3:]}}}
+        v = judge.judge(arms[arm], scene, {"waypoints": constant(q)})
+        assert "goal" not in v["failed"] and v["goal_position_error_m"] < 1e-5 and v["goal_angle_error_deg"] < 0.1, v
+        moved = copy.deepcopy(scene)
+        moved["goal"]["pose"]["position"][2] += 0.006
+        assert "goal" in judge.judge(arms[arm], moved, {"waypoints": constant(q)})["failed"]
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "iiwa7"])
+def test_other_arms_hold_objects_at_the_tcp_and_ignore_the_gripper(arms, arm):
+    # A 20 cm rod along the TCP link's z, its far end 30 cm out; a small sphere at that end
+    # touches only the rod. Moving the first joint moves the rod away.
+    r = arms[arm]
+    q = list(ARM_ENDS[arm][0])
+    rod = {"type": "cylinder", "center": [0, 0, 0.2], "radius": 0.01, "height": 0.2, "quaternion": [1, 0, 0, 0]}
+    judge.set_state(r, np.array(q))
+    tcp_pos, tcp_quat = judge.link_pose(r, r.tcp)
+    tip, _ = judge.p.multiplyTransforms(tcp_pos, tcp_quat, [0, 0, 0.3], [0, 0, 0, 1])
+    sphere = {"type": "sphere", "center": list(tip), "radius": 0.01}
+    scene = arm_scene(arm, q, q, [sphere]) | {"gripper": {"finger": 0.5}}  # no hand: ignored, even out of the Panda's range
+    assert judge.judge(r, scene, {"waypoints": constant(q)})["solved"]
+    v = judge.judge(r, scene | {"held_object": rod}, {"waypoints": constant(q)})
+    assert v["failed"] == ["contact"] and v["first_contact"]["link"] == judge.HELD and v["first_contact"]["obstacle"] == 0
+    away = list(q)
+    away[0] += 1.0
+    assert judge.judge(r, arm_scene(arm, away, away, [sphere]) | {"held_object": rod}, {"waypoints": constant(away)})["solved"]
+    # A 5 cm ball held at the TCP's origin overlaps the TCP link (and its parent): not a self
+    # pair. Grown to 15 cm it reaches the links further down: self-contact.
+    ball = {"type": "sphere", "center": [0, 0, 0], "radius": 0.05}
+    judge.set_state(r, np.array(q))
+    held = judge.spawn(r, ball | {"center": list(tcp_pos)})
+    judge.p.performCollisionDetection(physicsClientId=r.client)
+    assert judge.closest(r.client, held, r.body, 0.0, None, r.tcp) is not None
+    judge.p.removeBody(held, physicsClientId=r.client)
+    assert judge.judge(r, arm_scene(arm, q, q) | {"held_object": ball}, {"waypoints": constant(q)})["solved"]
+    v = judge.judge(r, arm_scene(arm, q, q) | {"held_object": ball | {"radius": 0.15}}, {"waypoints": constant(q)})
+    assert v["failed"] == ["contact"] and v["first_contact"]["kind"] == "self" and v["first_contact"]["link"] == judge.HELD
+    assert v["first_contact"]["other"] in ARM_LINKS[arm][:-2]
+
+
+def test_command_line_judges_every_arm(tmp_path, capsys):
+    problems = tmp_path / "problems"
+    write(problems / "cubby" / "003.json", SCENE)
+    rows = [{"problem": "cubby/003.json", "planner": "p", "status": "success", "waypoints": PLAN["waypoints"]}]
+    for arm, (start, goal) in ARM_ENDS.items():
+        write(problems / "posts" / f"{arm}.json", arm_scene(arm, start, goal, [TABLE, POST]))
+        rows.append({"problem": f"posts/{arm}.json", "planner": "p", "status": "success", "waypoints": polyline([start, ARM_CORNERS[arm]["over"], goal])})
+        write(problems / "through" / f"{arm}.json", arm_scene(arm, start, goal, [TABLE, POST]))
+        rows.append({"problem": f"through/{arm}.json", "planner": "p", "status": "success", "waypoints": polyline([start, ARM_CORNERS[arm]["through"], goal])})
+    run = tmp_path / "results.jsonl"
+    run.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    out = tmp_path / "verdicts.json"
+    code = judge.main(["--problems", str(problems), "--results", str(run), "--json", str(out), "--jobs", "2", "--no-progress"])
+    assert code == 1  # the two plans through the post
+    table = capsys.readouterr().out
+    assert "| cubby | 1 | 1 | 1 | 0 | 0 |" in table  # the Panda's row, as before
+    assert "| posts (iiwa7) | 1 | 1 | 1 | 0 | 0 |" in table and "| posts (xarm6) | 1 | 1 | 1 | 0 | 0 |" in table
+    assert "| through (xarm6) | 1 | 1 | 0 | 1 | 0 |" in table
+    assert "- through/xarm6.json [xarm6]: contact link" in table and "- through/iiwa7.json [iiwa7]: contact lbr_iiwa_link_" in table
+    verdicts = {v["problem"]: v for v in json.loads(out.read_text())["verdicts"]}
+    assert "robot" not in verdicts["cubby/003.json"] and verdicts["posts/xarm6.json"]["robot"] == "xarm6"
+    # An unknown robot is bad input.
+    write(problems / "posts" / "xarm6.json", arm_scene("ur5", *ARM_ENDS["xarm6"]))
+    assert judge.main(["--problems", str(problems), "--results", str(run), "--jobs", "1", "--no-progress"]) == 2
+
+
+def ball_distance(r: judge.Robot, center: list[float], radius: float, link: int) -> float:
+    """PyBullet's distance from a ball to one link of the arm in its current state."""
+    ball = judge.spawn(r, {"type": "sphere", "center": center, "radius": radius})
+    try:
+        judge.p.performCollisionDetection(physicsClientId=r.client)
+        d = judge.closest(r.client, ball, r.body, 1.0, None, link)
+        return 1.0 if d is None else d
+    finally:
+        judge.p.removeBody(ball, physicsClientId=r.client)
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "iiwa7"])
+def test_other_arms_clouds_skip_the_base_link(arms, arm):
+    # Three 1 cm balls against the base link's side, 5 cm up, touch it and nothing else: free,
+    # the base is bolted down. The arm leans forward and down, so that the balls lie within the
+    # moving links' bounds and are probed one by one. The same balls beside the first moving
+    # link touch it: contact.
+    r = arms[arm]
+    q = {"xarm6": [0, 0.5, -0.8, 0, 1.3, 0], "iiwa7": [0, 1.2, 0, -1.5, 0, 1.0, 0]}[arm]
+    x = {"xarm6": 0.055, "iiwa7": 0.115}[arm]  # 1 to 6 mm out of the base link's hull
+    low = [[x, y, 0.05] for y in (-0.02, 0.0, 0.02)]
+    judge.set_state(r, np.array(q))
+    assert all(ball_distance(r, c, 0.01, r.fixed[0]) <= 0.0 for c in low)
+    assert all(ball_distance(r, c, 0.01, link) > 0.05 for c in low for link in r.moving)
+    assert judge.near_robot(r, np.asarray(low), 0.01).all()  # filter_robot measures to the base too
+    cloud = {"type": "points", "points": low, "radius": 0.01}
+    v = judge.judge(r, arm_scene(arm, q, q, [cloud]), {"waypoints": constant(q)})
+    assert v["solved"], v
+    judge.set_state(r, np.array(q))
+    link1_lo, link1_hi = judge.p.getAABB(r.body, r.moving[0], physicsClientId=r.client)
+    high = [[link1_hi[0] - 0.01, y, (link1_lo[2] + link1_hi[2]) / 2] for y in (-0.02, 0.0, 0.02)]
+    assert any(ball_distance(r, c, 0.01, r.moving[0]) <= 0.0 for c in high)
+    v = judge.judge(r, arm_scene(arm, q, q, [cloud | {"points": high}]), {"waypoints": constant(q)})
+    assert v["failed"] == ["contact"] and v["first_contact"]["link"] == ARM_LINKS[arm][1] and v["first_contact"]["obstacle"] == 0
+    assert judge.p.getNumBodies(physicsClientId=r.client) == 1

@@ -3,8 +3,6 @@
 //! diversity as ACSM (the mean cosine similarity over all pairs of a batch's trajectories,
 //! each flattened to one vector; lower is more diverse).
 
-use edmp_core::robot::kinematics::Joints;
-
 /// The paper's four roughness numbers of one trajectory (radians).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Roughness {
@@ -42,12 +40,12 @@ pub(crate) fn roughness<const J: usize>(path: &[[f32; J]]) -> Roughness {
 }
 
 /// Joint-space length of a trajectory (radians).
-pub(crate) fn path_length(path: &[Joints<f32>]) -> f64 {
+pub(crate) fn path_length<const J: usize>(path: &[[f32; J]]) -> f64 {
     path.windows(2).map(|w| step_norm(&w[0], &w[1])).sum()
 }
 
 /// Average Cosine Similarity Mean of a batch (None for fewer than two trajectories).
-pub(crate) fn acsm(batch: &[&[Joints<f32>]]) -> Option<f64> {
+pub(crate) fn acsm<const J: usize>(batch: &[&[[f32; J]]]) -> Option<f64> {
     let flat: Vec<Vec<f64>> = batch
         .iter()
         .map(|p| p.iter().flatten().map(|v| f64::from(*v)).collect())

@@ -5,17 +5,24 @@
 //!   ACSM diversity, the waypoints), which `benchmarks/judge.py` and `bench-report` read;
 //! - `summary.md`: a table per family;
 //! - `success.png` (success per family) and `time.png` (distribution of planning times).
+//!
+//! `--robot NAME` runs another arm's suite (`benchmarks/NAME/problems` by default); every scene
+//! must name that arm.
 
 use crate::Failure;
+use crate::arm::Arm;
+use crate::commands::gen_suite::Suite;
 use crate::commands::plan::Tuning;
-use crate::formats::json::{Goal, parse_problem_in};
+use crate::formats::json::{Goal, parse_problem_for};
 use crate::metrics::{Roughness, acsm, path_length, roughness};
 use crate::planning::{chosen_guides, plan_problem_on};
 use crate::plots;
+use crate::with_arm;
 use core::time::Duration;
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::planner::Stage;
-use edmp_core::robot::kinematics::Joints;
+use edmp_core::prior::Network;
+use edmp_core::robot::Robot;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -34,9 +41,13 @@ pub enum Planner {
 /// Arguments of `edmp-host bench`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Folder with one sub-folder of `edmp-scene/1` files per family.
-    #[arg(long, default_value = "benchmarks/problems")]
-    problems: PathBuf,
+    /// Folder with one sub-folder of `edmp-scene/1` files per family (default: the arm's
+    /// in-distribution suite, `benchmarks/problems` for the Panda).
+    #[arg(long)]
+    problems: Option<PathBuf>,
+    /// The arm whose problems these are (docs/formats.md, "Other arms").
+    #[arg(long, value_enum, default_value_t = Arm::Panda)]
+    robot: Arm,
     /// Problems per family (the first N of each).
     #[arg(long, default_value_t = 100)]
     per_family: usize,
@@ -128,8 +139,8 @@ pub struct Record {
     pub candidates: Vec<Candidate>,
     /// Mean pairwise cosine similarity of the ensemble's candidates (EDMP; lower: more diverse).
     pub acsm: Option<f64>,
-    /// The returned path (50 × 7; empty without a path).
-    pub waypoints: Vec<Joints<f32>>,
+    /// The returned path (50 × the arm's joints; empty without a path).
+    pub waypoints: Vec<Vec<f32>>,
 }
 
 impl Record {
@@ -160,20 +171,33 @@ fn label(args: &Args, guides: &[u8]) -> String {
     }
 }
 
-fn run_edmp(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record, Failure> {
+/// One problem's text, where its files lie, and its name in tables.
+struct Job<'a> {
+    text: &'a str,
+    dir: &'a Path,
+    problem: &'a str,
+}
+
+fn run_edmp(args: &Args, job: &Job<'_>) -> Result<Record, Failure> {
+    // `with_arm!` returns the error of an arm without a trained prior from this closure.
+    let on_arm = || -> Result<Result<Record, Failure>, String> {
+        Ok(with_arm!(args.robot, robot, network => run_edmp_for(robot, network, args, job)))
+    };
+    on_arm().map_err(Failure::Input)?
+}
+
+fn run_edmp_for<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    network: &'static Network<J>,
+    args: &Args,
+    &Job { text, dir, problem }: &Job<'_>,
+) -> Result<Record, Failure> {
     let reading = std::time::Instant::now();
-    let parsed = parse_problem_in(text, dir).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
+    let parsed = parse_problem_for(text, dir, robot).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
     let read_ms = reading.elapsed().as_secs_f64() * 1e3;
     let guides = args.tuning.guides(&args.guides)?;
     let config = args.tuning.config()?;
-    let planned = plan_problem_on(
-        edmp_core::prior::PANDA,
-        &parsed,
-        &guides,
-        &config,
-        args.seed,
-        args.tuning.threads()?,
-    )?;
+    let planned = plan_problem_on(network, &parsed, &guides, &config, args.seed, args.tuning.threads()?)?;
     let plan = &planned.plan;
     let per_guide = plan.paths.len() / guides.len();
     // A wave's rows are made together and a later wave runs only after an earlier one found
@@ -199,7 +223,7 @@ fn run_edmp(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record
         })
         .collect();
     // The candidates made (the first waves' alone when a later one did not run).
-    let batch: Vec<&[Joints<f32>]> = plan
+    let batch: Vec<&[[f32; J]]> = plan
         .paths
         .iter()
         .zip(&plan.verdicts)
@@ -225,13 +249,21 @@ fn run_edmp(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record
         waves: u8::try_from(waves_run).ok(),
         candidates,
         acsm: acsm(&batch),
-        waypoints: best.to_vec(),
+        waypoints: best.iter().map(|q| q.to_vec()).collect(),
     })
 }
 
-fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record, Failure> {
+fn run_rrt(args: &Args, job: &Job<'_>) -> Result<Record, Failure> {
+    with_arm!(args.robot, robot => run_rrt_for(robot, args, job))
+}
+
+fn run_rrt_for<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    args: &Args,
+    &Job { text, dir, problem }: &Job<'_>,
+) -> Result<Record, Failure> {
     let reading = std::time::Instant::now();
-    let parsed = parse_problem_in(text, dir).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
+    let parsed = parse_problem_for(text, dir, robot).map_err(|e| Failure::Input(format!("{problem}: {e}")))?;
     let read_ms = reading.elapsed().as_secs_f64() * 1e3;
     let goal = match parsed.goal {
         Goal::Joints(q) => q,
@@ -242,8 +274,8 @@ fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record,
         ..crate::rrt::RrtConfig::default()
     };
     let began = std::time::Instant::now();
-    let planned = crate::rrt::plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
-        &edmp_core::robot::PANDA,
+    let planned = crate::rrt::plan::<50, J, { edmp_core::scene::MAX_OBSTACLES }>(
+        robot,
         &parsed.scene(),
         &parsed.start,
         &goal,
@@ -251,16 +283,10 @@ fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record,
         args.seed,
     );
     let time_ms = began.elapsed().as_secs_f64() * 1e3;
-    let (status, waypoints) = match planned {
+    let (status, path) = match planned {
         Ok(p) => {
-            let report = check_trajectory(
-                &edmp_core::robot::PANDA,
-                &parsed.scene(),
-                &p.waypoints,
-                &CheckConfig::DEFAULT,
-                true,
-            )
-            .map_err(|e| Failure::Input(format!("{problem}: checker: {e}")))?;
+            let report = check_trajectory(robot, &parsed.scene(), &p.waypoints, &CheckConfig::DEFAULT, true)
+                .map_err(|e| Failure::Input(format!("{problem}: checker: {e}")))?;
             let status = if report.is_free() { "success" } else { "collision" };
             (status, p.waypoints.to_vec())
         }
@@ -277,15 +303,15 @@ fn run_rrt(args: &Args, text: &str, dir: &Path, problem: &str) -> Result<Record,
         status: status.to_owned(),
         time_ms,
         read_ms,
-        path_length: (!waypoints.is_empty()).then(|| path_length(&waypoints)),
-        roughness: (!waypoints.is_empty()).then(|| roughness(&waypoints)),
+        path_length: (!path.is_empty()).then(|| path_length(&path)),
+        roughness: (!path.is_empty()).then(|| roughness(&path)),
         guide: None,
         stage: None,
         global_ms: None,
         waves: None,
         candidates: Vec::new(),
         acsm: None,
-        waypoints,
+        waypoints: path.iter().map(|q| q.to_vec()).collect(),
     })
 }
 
@@ -347,7 +373,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     args.tuning.config()?;
     let label = label(args, &guides);
-    let folders = crate::commands::gen_suite::read_folder(&args.problems, args.per_family).map_err(input)?;
+    let problems = args
+        .problems
+        .clone()
+        .unwrap_or_else(|| Suite::InDistribution.default_folder(args.robot));
+    let folders = crate::commands::gen_suite::read_folder(&problems, args.per_family).map_err(input)?;
     let jobs: Vec<(String, PathBuf)> = folders
         .iter()
         .flat_map(|(family, files)| files.iter().map(move |f| (family.clone(), f.clone())))
@@ -364,9 +394,14 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
         let text = std::fs::read_to_string(path).map_err(|e| input(format!("{}: {e}", path.display())))?;
         let dir = path.parent().unwrap_or(Path::new("."));
+        let job = Job {
+            text: &text,
+            dir,
+            problem: &name,
+        };
         let planned = match args.planner {
-            Planner::Edmp => run_edmp(args, &text, dir, &name),
-            Planner::RrtConnect => run_rrt(args, &text, dir, &name),
+            Planner::Edmp => run_edmp(args, &job),
+            Planner::RrtConnect => run_rrt(args, &job),
         };
         bar.inc(1);
         match planned {

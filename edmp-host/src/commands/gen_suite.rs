@@ -4,11 +4,16 @@
 //! processed in parallel batches but kept in seed order, so the output depends only on the
 //! arguments. `--suite in-distribution` (the default) makes `benchmarks/problems` from the
 //! training families; `--suite unseen` makes `benchmarks/unseen` from the kinds the prior
-//! never saw, on seeds far from every in-distribution family's.
+//! never saw, on seeds far from every in-distribution family's. `--robot NAME` makes another
+//! arm's suites (`benchmarks/NAME/problems`, `benchmarks/NAME/unseen`) from the same seeds:
+//! the same environments, that arm's ends.
 
+use crate::arm::Arm;
 use crate::rrt::{RrtConfig, plan};
-use crate::scenes::{Family, Kind, Problem, problem};
+use crate::scenes::{Family, Kind, Problem, problem_for};
+use crate::with_arm;
 use core::time::Duration;
+use edmp_core::robot::Robot;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 /// A problem folder as written by `gen-suite`: each family's name and its first `per_family`
@@ -38,9 +43,7 @@ pub fn read_folder(root: &std::path::Path, per_family: usize) -> Result<Vec<(Str
     Ok(out)
 }
 
-#[cfg(test)]
-use std::path::Path;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Which committed suite to make.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -61,8 +64,17 @@ impl Suite {
 
     fn folder(self) -> &'static str {
         match self {
-            Suite::InDistribution => "benchmarks/problems",
-            Suite::Unseen => "benchmarks/unseen",
+            Suite::InDistribution => "problems",
+            Suite::Unseen => "unseen",
+        }
+    }
+
+    /// Where `arm`'s suite lives: `benchmarks/problems` for the Panda, `benchmarks/NAME/problems`
+    /// for another arm (and `unseen` likewise).
+    pub fn default_folder(self, arm: Arm) -> PathBuf {
+        match arm {
+            Arm::Panda => Path::new("benchmarks").join(self.folder()),
+            other => Path::new("benchmarks").join(other.name()).join(self.folder()),
         }
     }
 }
@@ -91,31 +103,35 @@ pub struct Args {
     /// Only these families of the suite (default: all four).
     #[arg(long, value_enum)]
     family: Vec<Family>,
+    /// The arm (docs/formats.md, "Other arms"): the problems' ends are its own.
+    #[arg(long, value_enum, default_value_t = Arm::Panda)]
+    robot: Arm,
 }
 
 const KINDS: [Kind; 3] = [Kind::TaskOriented, Kind::NeutralStart, Kind::NeutralGoal];
 
-/// A problem from `seed`, if it exists and RRT-Connect solves it within `budget`.
-pub(crate) fn solvable(family: Family, seed: u64, budget: Duration) -> Option<Problem> {
-    let p = problem(family, KINDS[(seed % 3) as usize], seed)?;
+/// `robot`'s problem from `seed`, if it exists and RRT-Connect solves it within `budget`.
+pub(crate) fn solvable<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    family: Family,
+    seed: u64,
+    budget: Duration,
+) -> Option<Problem<J>> {
+    let p = problem_for(robot, family, KINDS[(seed % 3) as usize], seed)?;
     let config = RrtConfig {
         budget,
         ..RrtConfig::default()
     };
-    plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
-        &edmp_core::robot::PANDA,
-        &p.scene,
-        &p.start,
-        &p.goal,
-        &config,
-        seed,
-    )
-    .ok()?;
+    plan::<50, J, { edmp_core::scene::MAX_OBSTACLES }>(robot, &p.scene, &p.start, &p.goal, &config, seed).ok()?;
     Some(p)
 }
 
 /// Writes the suite.
 pub fn run(args: &Args) -> Result<(), String> {
+    with_arm!(args.robot, robot => generate(robot, args))
+}
+
+fn generate<const J: usize>(robot: &'static Robot<f32, J>, args: &Args) -> Result<(), String> {
     let families: Vec<Family> = if args.family.is_empty() {
         args.suite.families().to_vec()
     } else {
@@ -125,10 +141,13 @@ pub fn run(args: &Args) -> Result<(), String> {
         return Err(format!(
             "--family {}: not a family of {} (see --suite)",
             f.name(),
-            args.suite.folder()
+            args.suite.default_folder(args.robot).display()
         ));
     }
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(args.suite.folder()));
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| args.suite.default_folder(args.robot));
     let budget = Duration::from_millis(args.solvable_ms);
     for &family in &families {
         let began = std::time::Instant::now();
@@ -145,7 +164,8 @@ pub fn run(args: &Args) -> Result<(), String> {
         while kept.len() < args.per_family && tried < 100 * args.per_family as u64 + 100 {
             let batch: Vec<u64> = (tried..tried + 16).map(|i| base + i).collect();
             tried += 16;
-            let found: Vec<Option<Problem>> = batch.par_iter().map(|&s| solvable(family, s, budget)).collect();
+            let found: Vec<Option<Problem<J>>> =
+                batch.par_iter().map(|&s| solvable(robot, family, s, budget)).collect();
             for p in found.into_iter().flatten() {
                 if kept.len() < args.per_family {
                     kept.push(p);
@@ -192,8 +212,10 @@ mod tests {
     fn generators_are_deterministic() {
         for family in Family::ALL.into_iter().chain(Family::UNSEEN) {
             for seed in [1u64, 2, 3] {
-                let a = problem(family, KINDS[(seed % 3) as usize], seed).map(|p| p.json());
-                let b = problem(family, KINDS[(seed % 3) as usize], seed).map(|p| p.json());
+                let a =
+                    problem_for(&edmp_core::robot::PANDA, family, KINDS[(seed % 3) as usize], seed).map(|p| p.json());
+                let b =
+                    problem_for(&edmp_core::robot::PANDA, family, KINDS[(seed % 3) as usize], seed).map(|p| p.json());
                 assert_eq!(a, b, "{family:?} seed {seed}");
             }
         }
@@ -301,7 +323,8 @@ mod tests {
                     if i % 20 != 0 {
                         return Ok(());
                     }
-                    let again = problem(family, KINDS[(seed % 3) as usize], seed).ok_or("no problem")?;
+                    let again = problem_for(&edmp_core::robot::PANDA, family, KINDS[(seed % 3) as usize], seed)
+                        .ok_or("no problem")?;
                     if serde_json::to_string(&again.json()).map_err(|e| e.to_string())? + "\n" != text {
                         return Err(format!("{name}: seed {seed} draws another problem"));
                     }

@@ -23,7 +23,7 @@ use edmp_core::collision::checker::{CheckConfig, check_state};
 use edmp_core::rng::Rng;
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{Joints, Pose};
-use edmp_core::robot::{PANDA, Robot};
+use edmp_core::robot::{JOINTS, PANDA, Robot};
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
 pub(crate) use environment::{Environment, Region};
 use serde_json::{Value, json};
@@ -89,16 +89,17 @@ impl Kind {
     }
 }
 
-/// A problem, ready to plan.
+/// A problem for an arm of `J` joints, ready to plan.
 #[derive(Clone, Debug)]
-pub(crate) struct Problem {
+pub(crate) struct Problem<const J: usize = JOINTS> {
+    pub robot: &'static Robot<f32, J>,
     pub family: Family,
     pub kind: Kind,
     pub seed: u64,
     pub env: Environment,
     pub scene: Scene<'static, MAX_OBSTACLES>,
-    pub start: Joints<f32>,
-    pub goal: Joints<f32>,
+    pub start: Joints<f32, J>,
+    pub goal: Joints<f32, J>,
     pub goal_pose: Pose<f32>,
 }
 
@@ -159,14 +160,21 @@ pub(crate) fn neutral<const J: usize>(
     None
 }
 
-/// Draws a problem of `family` and `kind` from `seed`: `None` when this seed's environment
-/// gives no reachable, collision-free ends (the caller moves on to the next seed).
-pub(crate) fn problem(family: Family, kind: Kind, seed: u64) -> Option<Problem> {
+/// Draws `robot`'s problem of `family` and `kind` from `seed`: `None` when this seed's
+/// environment gives no reachable, collision-free ends (the caller moves on to the next seed).
+/// Every arm gets the same environment from a seed; the ends are its own (its IK in the same
+/// regions, its neutral configuration).
+pub(crate) fn problem_for<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    family: Family,
+    kind: Kind,
+    seed: u64,
+) -> Option<Problem<J>> {
     let mut rng = Rng::new(seed);
     let env = environment(family, &mut rng);
     let scene = env.scene()?;
     if !env.goals.is_empty() {
-        return targeted(family, kind, seed, env, scene, &mut rng);
+        return targeted(robot, family, kind, seed, env, scene, &mut rng);
     }
     let n = env.regions.len() as u32;
     let first = rng.below(n) as usize;
@@ -179,25 +187,24 @@ pub(crate) fn problem(family: Family, kind: Kind, seed: u64) -> Option<Problem> 
     };
     let (start, goal, goal_pose) = match kind {
         Kind::TaskOriented => {
-            let (s, _) = reach(&PANDA, &scene, &env.regions[first], &mut rng, 20)?;
-            let (g, pose) = reach(&PANDA, &scene, &env.regions[second], &mut rng, 20)?;
+            let (s, _) = reach(robot, &scene, &env.regions[first], &mut rng, 20)?;
+            let (g, pose) = reach(robot, &scene, &env.regions[second], &mut rng, 20)?;
             (s, g, pose)
         }
         Kind::NeutralStart => {
-            let s = neutral(&PANDA, &scene, &mut rng)?;
-            let (g, pose) = reach(&PANDA, &scene, &env.regions[second], &mut rng, 20)?;
+            let s = neutral(robot, &scene, &mut rng)?;
+            let (g, pose) = reach(robot, &scene, &env.regions[second], &mut rng, 20)?;
             (s, g, pose)
         }
         Kind::NeutralGoal => {
-            let (s, _) = reach(&PANDA, &scene, &env.regions[first], &mut rng, 20)?;
-            let g = neutral(&PANDA, &scene, &mut rng)?;
-            let pose = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &g)
-                .ok()?
-                .tcp();
+            let (s, _) = reach(robot, &scene, &env.regions[first], &mut rng, 20)?;
+            let g = neutral(robot, &scene, &mut rng)?;
+            let pose = *edmp_core::robot::kinematics::forward(robot, &g).ok()?.tcp();
             (s, g, pose)
         }
     };
     Some(Problem {
+        robot,
         family,
         kind,
         seed,
@@ -211,39 +218,39 @@ pub(crate) fn problem(family: Family, kind: Kind, seed: u64) -> Option<Problem> 
 
 /// A problem of an environment with goal regions (the unseen kinds): the posed goal (or, for
 /// a neutral goal, the posed start) in a goal region, a task-oriented start in another region.
-fn targeted(
+fn targeted<const J: usize>(
+    robot: &'static Robot<f32, J>,
     family: Family,
     kind: Kind,
     seed: u64,
     env: Environment,
     scene: Scene<'static, MAX_OBSTACLES>,
     rng: &mut Rng,
-) -> Option<Problem> {
+) -> Option<Problem<J>> {
     let target = env.goals[rng.below(env.goals.len() as u32) as usize];
     // A task-oriented start avoids the goal's own region when there is another one.
     let others: Vec<&Region> = env.regions.iter().filter(|r| **r != target).collect();
     let (start, goal, goal_pose) = match kind {
         Kind::TaskOriented => {
             let from = *others.get(rng.below(others.len().max(1) as u32) as usize)?;
-            let (s, _) = reach(&PANDA, &scene, from, rng, 20)?;
-            let (g, pose) = reach(&PANDA, &scene, &target, rng, 20)?;
+            let (s, _) = reach(robot, &scene, from, rng, 20)?;
+            let (g, pose) = reach(robot, &scene, &target, rng, 20)?;
             (s, g, pose)
         }
         Kind::NeutralStart => {
-            let s = neutral(&PANDA, &scene, rng)?;
-            let (g, pose) = reach(&PANDA, &scene, &target, rng, 20)?;
+            let s = neutral(robot, &scene, rng)?;
+            let (g, pose) = reach(robot, &scene, &target, rng, 20)?;
             (s, g, pose)
         }
         Kind::NeutralGoal => {
-            let (s, _) = reach(&PANDA, &scene, &target, rng, 20)?;
-            let g = neutral(&PANDA, &scene, rng)?;
-            let pose = *edmp_core::robot::kinematics::forward(&edmp_core::robot::PANDA, &g)
-                .ok()?
-                .tcp();
+            let (s, _) = reach(robot, &scene, &target, rng, 20)?;
+            let g = neutral(robot, &scene, rng)?;
+            let pose = *edmp_core::robot::kinematics::forward(robot, &g).ok()?.tcp();
             (s, g, pose)
         }
     };
     Some(Problem {
+        robot,
         family,
         kind,
         seed,
@@ -255,16 +262,17 @@ fn targeted(
     })
 }
 
-impl Problem {
+impl<const J: usize> Problem<J> {
     /// The problem as an `edmp-scene/1` document (joint goal), with the matching TCP pose goal
-    /// and provenance under the optional `meta` field.
+    /// and provenance under the optional `meta` field; `robot` names any arm but the Panda
+    /// (whose scenes the format's default covers).
     pub(crate) fn json(&self) -> Value {
         let q = self.goal_pose.quaternion_wxyz();
-        json!({
+        let mut doc = json!({
             "format": "edmp-scene/1",
             "obstacles": self.env.prims.iter().map(primitive_json).collect::<Vec<_>>(),
-            "start": self.start,
-            "goal": {"joints": self.goal},
+            "start": self.start.to_vec(),
+            "goal": {"joints": self.goal.to_vec()},
             "meta": {
                 "family": self.family.name(),
                 "kind": self.kind.name(),
@@ -274,7 +282,11 @@ impl Problem {
                     "quaternion": q,
                 },
             },
-        })
+        });
+        if self.robot.name != PANDA.name {
+            doc["robot"] = json!(self.robot.name);
+        }
+        doc
     }
 }
 
@@ -450,7 +462,9 @@ mod tests {
             let mut found = 0;
             for seed in 0..12u64 {
                 let kind = [Kind::TaskOriented, Kind::NeutralStart][(seed % 2) as usize];
-                let Some(p) = problem(family, kind, seed) else { continue };
+                let Some(p) = problem_for(&PANDA, family, kind, seed) else {
+                    continue;
+                };
                 found += 1;
                 let t = p.goal_pose.translation;
                 let within = p.env.goals.iter().any(|g| {
@@ -462,5 +476,42 @@ mod tests {
             }
             assert!(found >= 3, "{family:?}: {found} problems of 12 seeds");
         }
+    }
+
+    /// Another arm's problems are the same environments with its own ends, written with its
+    /// `robot` name, and read back by the scene reader as valid ends of that arm.
+    fn other_arms_problems_read_back<const J: usize>(robot: &'static Robot<f32, J>) {
+        let mut found = 0;
+        for seed in 0..24u64 {
+            let kind = [Kind::TaskOriented, Kind::NeutralStart, Kind::NeutralGoal][(seed % 3) as usize];
+            let family = Family::ALL[(seed % 4) as usize];
+            let Some(p) = problem_for(robot, family, kind, seed) else {
+                continue;
+            };
+            found += 1;
+            let panda_env = environment(family, &mut Rng::new(seed));
+            assert_eq!(
+                p.env.prims, panda_env.prims,
+                "{family:?} seed {seed}: another environment"
+            );
+            let doc = p.json();
+            assert_eq!(doc["robot"], robot.name);
+            let text = serde_json::to_string(&doc).unwrap();
+            let back = crate::formats::json::parse_problem_for(&text, std::path::Path::new("."), robot)
+                .unwrap_or_else(|e| panic!("{} {family:?} seed {seed}: {e}", robot.name));
+            assert_eq!(back.start, p.start);
+        }
+        assert!(found >= 6, "{}: {found} problems of 24 seeds", robot.name);
+    }
+
+    #[test]
+    fn other_arms_draw_their_own_ends_in_the_same_environments() {
+        other_arms_problems_read_back(&edmp_core::robot::arms::iiwa7::ROBOT);
+        other_arms_problems_read_back(&edmp_core::robot::arms::xarm6::ROBOT);
+        let panda = problem_for(&PANDA, Family::Tabletop, Kind::TaskOriented, 0).map(|p| p.json());
+        assert!(
+            panda.is_none_or(|d| d.get("robot").is_none()),
+            "the Panda's scenes keep their bytes"
+        );
     }
 }
