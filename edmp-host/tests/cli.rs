@@ -34,6 +34,61 @@ fn rrt_plans_the_example_and_writes_the_file() {
     assert_eq!(waypoints[0].as_array().unwrap()[0].as_f64().unwrap() as f32, 0.6);
 }
 
+/// `plan` and `rrt` read the arm from the scene: an xArm 6 problem is planned with 6 joints and
+/// a 7-joint start is refused by its path; a Panda-only command names the arm it refuses.
+#[test]
+fn another_arms_scene_is_planned_with_its_joints_or_refused_by_name() {
+    let scene = "benchmarks/xarm6/problems/cubby/000.json";
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{}/../{scene}", env!("CARGO_MANIFEST_DIR"))).unwrap())
+            .unwrap();
+    for command in ["plan", "rrt"] {
+        let out = edmp_host(&[command, scene]);
+        assert!(
+            out.status.success(),
+            "{command}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let plan: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let waypoints = plan["waypoints"].as_array().unwrap();
+        assert_eq!(waypoints.len(), 50, "{command}");
+        assert!(waypoints.iter().all(|q| q.as_array().unwrap().len() == 6), "{command}");
+        let first: Vec<f64> = waypoints[0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let start: Vec<f64> = doc["start"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert!(
+            first.iter().zip(&start).all(|(a, b)| (a - b).abs() < 1e-4),
+            "{command}: {first:?}"
+        );
+    }
+    let dir = std::env::temp_dir().join(format!("edmp-xarm6-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let seven = dir.join("seven.json");
+    let mut bad = doc.clone();
+    bad["start"].as_array_mut().unwrap().push(serde_json::json!(0.0));
+    std::fs::write(&seven, bad.to_string()).unwrap();
+    let out = edmp_host(&["plan", seven.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("start: expected 6 numbers, found 7"));
+    let out = edmp_host(&["embed", scene, "--out", dir.join("embedded").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(r#"robot: "xarm6": this command runs the panda only"#),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 fn bad_input_names_the_field_exits_2_and_writes_nothing() {
     let dir = std::env::temp_dir().join(format!("edmp-bad-{}", std::process::id()));

@@ -2,9 +2,11 @@
 //! `edmp-plan/1` plan (status "success" only: without a path nothing is written, exit 1).
 
 use crate::Failure;
-use crate::formats::json::{joint_goal, parse_problem_in};
+use crate::formats::json::{joint_goal, parse_problem_for, scene_arm};
 use crate::rrt::{RrtConfig, RrtError, path_length, plan};
+use crate::with_arm;
 use core::time::Duration;
+use edmp_core::robot::Robot;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -25,20 +27,31 @@ pub struct Args {
     budget_ms: u64,
 }
 
-/// Plans and writes the plan.
+/// Plans for the arm the scene names (`robot`) and writes the plan.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let began = Instant::now();
     let text =
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let arm = scene_arm(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    with_arm!(arm, robot => plan_for(args, began, &text, robot))
+}
+
+fn plan_for<const J: usize>(
+    args: &Args,
+    began: Instant,
+    text: &str,
+    robot: &'static Robot<f32, J>,
+) -> Result<(), Failure> {
     let dir = args.scene.parent().unwrap_or(std::path::Path::new("."));
-    let problem = parse_problem_in(&text, dir).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let problem =
+        parse_problem_for(text, dir, robot).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let goal = joint_goal(&problem).map_err(Failure::Input)?;
     let config = RrtConfig {
         budget: Duration::from_millis(args.budget_ms),
         ..RrtConfig::default()
     };
-    let planned = plan::<50, { edmp_core::robot::JOINTS }, { edmp_core::scene::MAX_OBSTACLES }>(
-        &edmp_core::robot::PANDA,
+    let planned = plan::<50, J, { edmp_core::scene::MAX_OBSTACLES }>(
+        robot,
         &problem.scene(),
         &problem.start,
         &goal,
