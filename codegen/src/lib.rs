@@ -50,6 +50,24 @@ pub fn generate_robot(urdf: &Path, arm: &arms::ArmSpec) -> Result<GeneratedArm, 
             chain.joints.len()
         ));
     }
+    let d = &arm.dynamics;
+    for (what, values) in [("velocity", d.velocity), ("acceleration", d.acceleration), ("jerk", d.jerk)] {
+        if values.len() != chain.joints.len() {
+            return Err(format!(
+                "arm `{}`: dynamics.{what} has {} values, the URDF {} actuated joints",
+                arm.name,
+                values.len(),
+                chain.joints.len()
+            ));
+        }
+        // The time law divides by every limit: each must be a positive, finite number.
+        if let Some(i) = values.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(format!(
+                "arm `{}`: dynamics.{what}[{i}] = {} is not a positive, finite limit",
+                arm.name, values[i]
+            ));
+        }
+    }
     if let Some(i) = (0..chain.joints.len())
         .find(|&i| !(chain.joints[i].soft[0]..=chain.joints[i].soft[1]).contains(&arm.neutral[i]))
     {

@@ -5,6 +5,7 @@
 use core::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use edmp_core::path::HORIZON;
+use edmp_core::robot::PANDA;
 use edmp_core::robot::kinematics::Joints;
 use edmp_core::trajectory::{DEFAULT_GRID, Limits, Shape, Timed, parameterize};
 
@@ -85,7 +86,7 @@ fn bench(c: &mut Criterion) {
                 jerk_limited: jerk,
                 ..Limits::DEFAULT
             };
-            parameterize(&WALL, shape, &limits, &mut timed).unwrap();
+            parameterize(&PANDA, &WALL, shape, &limits, &mut timed).unwrap();
             println!(
                 "{shape:?}, jerk {jerk}: {:.4} s, scale {:.4}, {} grid points",
                 timed.duration(),
@@ -93,11 +94,11 @@ fn bench(c: &mut Criterion) {
                 timed.grid_points()
             );
             group.bench_function(format!("wall plan, {shape:?}, jerk_limited {jerk}"), |b| {
-                b.iter(|| parameterize(black_box(&WALL), shape, &limits, &mut timed))
+                b.iter(|| parameterize(&PANDA, black_box(&WALL), shape, &limits, &mut timed))
             });
         }
     }
-    parameterize(&WALL, Shape::Spline, &Limits::DEFAULT, &mut timed).unwrap();
+    parameterize(&PANDA, &WALL, Shape::Spline, &Limits::DEFAULT, &mut timed).unwrap();
     let d = timed.duration();
     group.bench_function("sample one setpoint", |b| {
         let mut t = 0.0f32;

@@ -104,6 +104,14 @@ pub struct Robot<T: 'static, const J: usize> {
     /// The ready configuration: the gripper pointing down in front of the base (the Panda:
     /// MpiNets' neutral). Scene generators start or end problems near it.
     pub neutral: [T; J],
+    /// Largest joint velocity (rad/s): the time law's bound (`crate::trajectory`). Not in a
+    /// URDF for every arm, so each arm's spec in `edmp-codegen` names its source (the
+    /// generated tables say it beside the numbers).
+    pub max_velocity: [T; J],
+    /// Largest joint acceleration (rad/s²), from the same spec.
+    pub max_acceleration: [T; J],
+    /// Largest joint jerk (rad/s³), from the same spec.
+    pub max_jerk: [T; J],
     /// The gripper, for arms with one.
     pub gripper: Option<Gripper<T>>,
     /// Per body and joint, how far a point of the body can be from the joint's axis, in `f32`

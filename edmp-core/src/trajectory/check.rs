@@ -3,7 +3,7 @@
 use super::spline::{Curve, Shape, deviation_bound, validate_waypoints};
 use crate::collision::checker::{CheckConfig, MAX_STEPS_PER_SEGMENT, check_segment};
 use crate::error::Error;
-use crate::robot::kinematics::Joints;
+use crate::robot::Robot;
 use crate::scene::Scene;
 
 /// Fraction of the checker's step the curve's samples keep to, so that `f32` rounding of the
@@ -22,7 +22,7 @@ pub struct CurveReport {
     pub tolerance: f32,
 }
 
-/// Checks the curve of `shape` through `waypoints` with the exact checker, stopping at the
+/// Checks the curve of `shape` through `waypoints` of `robot` with the exact checker, stopping at the
 /// first contact. Each span is sampled uniformly in `u`, as many samples as keep every joint's
 /// step ≤ `0.99 config.max_step` (from the span's derivative bound, so between the samples
 /// nothing is skipped at the checker's resolution); the samples go to
@@ -30,9 +30,10 @@ pub struct CurveReport {
 /// state is checked once. The ends (margins near the start and goal) are the first and last
 /// waypoint. A span needing more than [`MAX_STEPS_PER_SEGMENT`] samples is
 /// [`Error::SegmentTooLong`], as in the checker.
-pub fn check_curve<const H: usize, const M: usize>(
+pub fn check_curve<const H: usize, const J: usize, const M: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<M>,
-    waypoints: &[Joints<f32>; H],
+    waypoints: &[[f32; J]; H],
     shape: Shape,
     config: &CheckConfig,
 ) -> Result<CurveReport, Error> {
@@ -50,8 +51,8 @@ pub fn check_curve<const H: usize, const M: usize>(
         states: 0,
         tolerance: deviation_bound(waypoints, shape),
     };
-    let mut pending: Option<Joints<f32>> = None;
-    let mut visit = |q: Joints<f32>, report: &mut CurveReport| -> Result<bool, Error> {
+    let mut pending: Option<[f32; J]> = None;
+    let mut visit = |q: [f32; J], report: &mut CurveReport| -> Result<bool, Error> {
         match pending.take() {
             None => {
                 pending = Some(q);
@@ -59,7 +60,7 @@ pub fn check_curve<const H: usize, const M: usize>(
             }
             Some(a) => {
                 report.states += 2;
-                check_segment(&crate::robot::PANDA, scene, &a, &q, [first, last], config)
+                check_segment(robot, scene, &a, &q, [first, last], config)
             }
         }
     };
@@ -82,7 +83,7 @@ pub fn check_curve<const H: usize, const M: usize>(
     }
     if let Some(a) = pending {
         report.states += 1;
-        report.free = check_segment(&crate::robot::PANDA, scene, &a, &a, [first, last], config)?;
+        report.free = check_segment(robot, scene, &a, &a, [first, last], config)?;
     }
     Ok(report)
 }

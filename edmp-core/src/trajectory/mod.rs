@@ -1,5 +1,8 @@
-//! Time parameterization: a planned path becomes a time-stamped trajectory inside Franka's
-//! velocity, acceleration and jerk limits, starting and ending at rest.
+//! Time parameterization: a planned path becomes a time-stamped trajectory inside the arm's
+//! velocity, acceleration and jerk limits ([`Robot::max_velocity`],
+//! [`Robot::max_acceleration`], [`Robot::max_jerk`], frozen with its tables), starting and
+//! ending at rest. Any arm: the functions take its [`Robot`] table and are generic over its
+//! number of joints `J`.
 //!
 //! 1. **Shape** ([`spline`]): the waypoints as control points of a uniform cubic B-spline (C²,
 //!    within [`deviation_bound`] of the polyline), or the exact polyline.
@@ -16,13 +19,14 @@
 //! its own rate and nothing is buffered. Everything is `f32`, fixed memory, deterministic.
 //!
 //! ```
+//! use edmp_core::robot::PANDA;
 //! use edmp_core::trajectory::{Limits, Shape, Timed, parameterize};
 //! let waypoints: [[f32; 7]; 50] = core::array::from_fn(|k| {
 //!     let s = k as f32 / 49.0;
 //!     [s, -0.785, 0.5 * s, -2.356, 0.0, 1.571, 0.785]
 //! });
-//! let mut timed = Timed::<{ edmp_core::trajectory::DEFAULT_GRID }, 50>::new();
-//! parameterize(&waypoints, Shape::Spline, &Limits::DEFAULT, &mut timed).unwrap();
+//! let mut timed = Timed::<{ edmp_core::trajectory::DEFAULT_GRID }, 50, 7>::new();
+//! parameterize(&PANDA, &waypoints, Shape::Spline, &Limits::DEFAULT, &mut timed).unwrap();
 //! let end = timed.sample(timed.duration());
 //! assert_eq!(end.positions, waypoints[49]);
 //! assert_eq!(end.velocities, [0.0; 7]);
@@ -41,8 +45,7 @@ pub use spline::{Curve, Shape, deviation_bound};
 use crate::collision::checker::CheckConfig;
 use crate::error::Error;
 use crate::path::HORIZON;
-use crate::robot::JOINTS;
-use crate::robot::kinematics::Joints;
+use crate::robot::{JOINTS, Robot};
 use crate::scene::Scene;
 use profile::{Law, Profile};
 
@@ -52,8 +55,9 @@ pub const MAX_GRID_PER_SPAN: usize = 4;
 /// Grid capacity that gives a 50-waypoint path [`MAX_GRID_PER_SPAN`] points per span in either
 /// shape (the polyline's `3·50 − 3 = 147` spans, plus the last point).
 pub const DEFAULT_GRID: usize = MAX_GRID_PER_SPAN * (3 * HORIZON - 3) + 1;
-/// Moving-average window in units of the largest `a_j / j_j` (2 ms for Franka, whatever the
-/// scale): the filter's own jerk, about `|q'| · 2 max|ü| / w`, then stays well inside the limit.
+/// Moving-average window in units of the arm's largest `a_j / j_j` (whatever the scale: 2 ms
+/// for the Panda's datasheet, longer for an arm whose jerk limit is lower): the filter's own
+/// jerk, about `|q'| · 2 max|ü| / w`, then stays well inside the limit.
 pub const WINDOW_FACTOR: f32 = 4.0;
 /// Relative margin added to every measured time scale.
 pub const SAFETY: f32 = 0.01;
@@ -62,29 +66,32 @@ pub const RETRIES: usize = 3;
 /// Longest trajectory (s): anything slower is [`Error::Overflow`].
 pub const MAX_DURATION: f32 = 3600.0;
 
-/// One setpoint of a trajectory.
+/// One setpoint of a trajectory of an arm with `J` joints (the Panda's 7 unless named, as
+/// `Plan`'s).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TimedPoint {
+pub struct TimedPoint<const J: usize = JOINTS> {
     /// Seconds from the start.
     pub time: f32,
     /// rad.
-    pub positions: Joints<f32>,
+    pub positions: [f32; J],
     /// rad/s.
-    pub velocities: Joints<f32>,
+    pub velocities: [f32; J],
     /// rad/s².
-    pub accelerations: Joints<f32>,
+    pub accelerations: [f32; J],
 }
 
-/// A time-parameterized path, in fixed memory: the waypoints, the TOPP grid (`u̇²` and the
-/// time at each of up to `N` grid points), the filter window and the time scale.
+/// A time-parameterized path of `H` waypoints of an arm with `J` joints (the Panda's 7 unless
+/// named), in fixed memory: the waypoints, the TOPP grid (`u̇²` and the time at each of up to
+/// `N` grid points), the filter window and the time scale. It keeps no arm: the limits were
+/// applied when it was timed, and sampling needs only the curve and the law.
 ///
-/// Memory: `8 N + 28 H` bytes plus a few scalars ([`Timed::BYTES`]; about 11 KB for the
+/// Memory: `8 N + 4 J H` bytes plus a few scalars ([`Timed::BYTES`]; about 11 KB for the
 /// defaults), so a firmware keeps it in a `static` (`const fn new`). Until a successful
 /// [`parameterize`] (and after a failed one) it is the empty trajectory: duration 0, at rest at
 /// zero.
 #[derive(Clone, Debug)]
-pub struct Timed<const N: usize = DEFAULT_GRID, const H: usize = HORIZON> {
-    waypoints: [Joints<f32>; H],
+pub struct Timed<const N: usize = DEFAULT_GRID, const H: usize = HORIZON, const J: usize = JOINTS> {
+    waypoints: [[f32; J]; H],
     shape: Shape,
     limits: Limits,
     per_span: usize,
@@ -97,20 +104,20 @@ pub struct Timed<const N: usize = DEFAULT_GRID, const H: usize = HORIZON> {
     tolerance: f32,
 }
 
-impl<const N: usize, const H: usize> Default for Timed<N, H> {
+impl<const N: usize, const H: usize, const J: usize> Default for Timed<N, H, J> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const N: usize, const H: usize> Timed<N, H> {
+impl<const N: usize, const H: usize, const J: usize> Timed<N, H, J> {
     /// Bytes this type occupies.
     pub const BYTES: usize = core::mem::size_of::<Self>();
 
     /// The empty trajectory.
     pub const fn new() -> Self {
         Self {
-            waypoints: [[0.0; JOINTS]; H],
+            waypoints: [[0.0; J]; H],
             shape: Shape::Spline,
             limits: Limits::DEFAULT,
             per_span: 0,
@@ -125,7 +132,7 @@ impl<const N: usize, const H: usize> Timed<N, H> {
     }
 
     fn clear(&mut self) {
-        self.waypoints = [[0.0; JOINTS]; H];
+        self.waypoints = [[0.0; J]; H];
         self.per_span = 0;
         self.points = 0;
         self.window = 0.0;
@@ -170,7 +177,7 @@ impl<const N: usize, const H: usize> Timed<N, H> {
     }
 
     /// The waypoints it follows.
-    pub fn waypoints(&self) -> &[Joints<f32>; H] {
+    pub fn waypoints(&self) -> &[[f32; J]; H] {
         &self.waypoints
     }
 
@@ -185,7 +192,7 @@ impl<const N: usize, const H: usize> Timed<N, H> {
     }
 
     /// The setpoint at `time` (clamped into `[0, duration]`; NaN reads as 0).
-    pub fn sample(&self, time: f32) -> TimedPoint {
+    pub fn sample(&self, time: f32) -> TimedPoint<J> {
         let time = if time > 0.0 { time.min(self.duration) } else { 0.0 };
         let k = self.scale;
         let law = self.profile().law(time / k);
@@ -194,8 +201,8 @@ impl<const N: usize, const H: usize> Timed<N, H> {
         let mut out = TimedPoint {
             time,
             positions: p.q,
-            velocities: [0.0; JOINTS],
-            accelerations: [0.0; JOINTS],
+            velocities: [0.0; J],
+            accelerations: [0.0; J],
         };
         for (j, (d1, d2)) in p.d1.iter().zip(&p.d2).enumerate() {
             if let (Some(vel), Some(acc)) = (out.velocities.get_mut(j), out.accelerations.get_mut(j)) {
@@ -232,57 +239,61 @@ impl<const N: usize, const H: usize> Timed<N, H> {
     }
 }
 
-/// Times the curve of `shape` through `waypoints` into `out` under `limits`: TOPP under the
-/// (scaled) velocity and acceleration limits; with `limits.jerk_limited`, the moving average
-/// and the time scale that bound the jerk (jerk limit = Franka's × `acceleration_scale`).
+/// Times the curve of `shape` through `waypoints` of `robot` into `out` under `limits`: TOPP
+/// under the arm's velocity and acceleration limits, scaled; with `limits.jerk_limited`, the
+/// moving average and the time scale that bound the jerk (jerk limit = the arm's ×
+/// `acceleration_scale`).
 ///
 /// Errors: [`Error::BadScale`], [`Error::NonFiniteJoint`] / [`Error::OutOfRange`] for a bad
 /// waypoint, [`Error::BadParameter`] for `H = 0`, [`Error::GridTooSmall`] when `N` cannot hold a
 /// point per span, [`Error::Overflow`] when the trajectory would last over [`MAX_DURATION`]. On
 /// error `out` is left empty. Waypoints that are all equal give a trajectory at rest, of
 /// duration 0.
-pub fn parameterize<const N: usize, const H: usize>(
-    waypoints: &[Joints<f32>; H],
+pub fn parameterize<const N: usize, const H: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
+    waypoints: &[[f32; J]; H],
     shape: Shape,
     limits: &Limits,
-    out: &mut Timed<N, H>,
+    out: &mut Timed<N, H, J>,
 ) -> Result<(), Error> {
     out.clear();
-    let result = fill(waypoints, shape, limits, out);
+    let result = fill(robot, waypoints, shape, limits, out);
     if result.is_err() {
         out.clear();
     }
     result
 }
 
-/// Checks the spline with [`check_curve`] and times it when free; otherwise times the exact
-/// polyline, which the planner's own check covered (it is not re-checked here). Returns the
-/// shape used.
-pub fn parameterize_checked<const N: usize, const H: usize, const M: usize>(
+/// Checks the spline with [`check_curve`] (the arm `robot` in `scene`) and times it when free;
+/// otherwise times the exact polyline, which the planner's own check covered (it is not
+/// re-checked here). Returns the shape used.
+pub fn parameterize_checked<const N: usize, const H: usize, const J: usize, const M: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<M>,
-    waypoints: &[Joints<f32>; H],
+    waypoints: &[[f32; J]; H],
     limits: &Limits,
     check: &CheckConfig,
-    out: &mut Timed<N, H>,
+    out: &mut Timed<N, H, J>,
 ) -> Result<Shape, Error> {
     out.clear();
-    limits.joint_limits()?;
-    let shape = if check_curve(scene, waypoints, Shape::Spline, check)?.free {
+    limits.joint_limits(robot)?;
+    let shape = if check_curve(robot, scene, waypoints, Shape::Spline, check)?.free {
         Shape::Spline
     } else {
         Shape::Polyline
     };
-    parameterize(waypoints, shape, limits, out)?;
+    parameterize(robot, waypoints, shape, limits, out)?;
     Ok(shape)
 }
 
-fn fill<const N: usize, const H: usize>(
-    waypoints: &[Joints<f32>; H],
+fn fill<const N: usize, const H: usize, const J: usize>(
+    robot: &Robot<f32, J>,
+    waypoints: &[[f32; J]; H],
     shape: Shape,
     limits: &Limits,
-    out: &mut Timed<N, H>,
+    out: &mut Timed<N, H, J>,
 ) -> Result<(), Error> {
-    let joint = limits.joint_limits()?;
+    let joint = limits.joint_limits(robot)?;
     spline::validate_waypoints(waypoints)?;
     let Some(first) = waypoints.first() else {
         return Err(Error::BadParameter);
@@ -342,11 +353,11 @@ fn fill<const N: usize, const H: usize>(
 
 /// Largest ratio of demand to limit at `τ` (velocity as is, acceleration under a square root,
 /// jerk under a cube root: each is what a time scale divides out).
-fn demand<const H: usize>(curve: &Curve<'_, H>, law: Law, limits: &JointLimits, jerk: bool) -> f32 {
+fn demand<const H: usize, const J: usize>(curve: &Curve<'_, H, J>, law: Law, limits: &JointLimits<J>, jerk: bool) -> f32 {
     let p = curve.eval(law.u);
     let (mut rv, mut ra, mut rj) = (0.0f32, 0.0f32, 0.0f32);
-    for j in 0..JOINTS {
-        let g = |x: &Joints<f32>| x.get(j).copied().unwrap_or(0.0);
+    for j in 0..J {
+        let g = |x: &[f32; J]| x.get(j).copied().unwrap_or(0.0);
         let (d1, d2, d3) = (g(&p.d1), g(&p.d2), g(&p.d3));
         let (vl, al, jl) = (g(&limits.velocity), g(&limits.acceleration), g(&limits.jerk));
         rv = rv.max((d1 * law.v).abs() / vl);
@@ -360,10 +371,10 @@ fn demand<const H: usize>(curve: &Curve<'_, H>, law: Law, limits: &JointLimits, 
 }
 
 /// Largest [`demand`] at the given fractions of every piece of the law.
-fn sampled_demand<const H: usize>(
-    curve: &Curve<'_, H>,
+fn sampled_demand<const H: usize, const J: usize>(
+    curve: &Curve<'_, H, J>,
     profile: &Profile<'_>,
-    limits: &JointLimits,
+    limits: &JointLimits<J>,
     jerk: bool,
     fractions: &[f32],
 ) -> f32 {
@@ -378,7 +389,12 @@ fn sampled_demand<const H: usize>(
 
 /// The uniform time scale: measured at the start and middle of every piece, verified at its
 /// quarters, at most [`RETRIES`] rounds, never above the analytic bound [`safe_scale`].
-fn time_scale<const H: usize>(curve: &Curve<'_, H>, profile: &Profile<'_>, limits: &JointLimits, jerk: bool) -> f32 {
+fn time_scale<const H: usize, const J: usize>(
+    curve: &Curve<'_, H, J>,
+    profile: &Profile<'_>,
+    limits: &JointLimits<J>,
+    jerk: bool,
+) -> f32 {
     let safe = safe_scale(curve, profile, limits, jerk);
     let mut k = (sampled_demand(curve, profile, limits, jerk, &[0.0, 0.5]) * (1.0 + SAFETY)).max(1.0);
     for _ in 0..RETRIES {
@@ -398,7 +414,12 @@ fn time_scale<const H: usize>(curve: &Curve<'_, H>, profile: &Profile<'_>, limit
 /// `|q̈| ≤ Q₁U₂ + Q₂U₁²`, `|q⃛| ≤ Q₃U₁³ + 3Q₂U₁U₂ + Q₁U₃`, with `Qₙ` the curve's derivative bounds
 /// and `U₁ = max u̇`, `U₂ = max |ü|`, `U₃ = 2U₂/w` the law's (the filter only averages `u̇` and
 /// `ü`). Slow (the maxima rarely meet), hence only the last resort.
-fn safe_scale<const H: usize>(curve: &Curve<'_, H>, profile: &Profile<'_>, limits: &JointLimits, jerk: bool) -> f32 {
+fn safe_scale<const H: usize, const J: usize>(
+    curve: &Curve<'_, H, J>,
+    profile: &Profile<'_>,
+    limits: &JointLimits<J>,
+    jerk: bool,
+) -> f32 {
     let [q1, q2, q3] = curve.derivative_bounds();
     let x_max = profile.x.iter().fold(0.0f32, |m, x| m.max(*x));
     let u1 = crate::float::sqrt(x_max);
@@ -408,8 +429,8 @@ fn safe_scale<const H: usize>(curve: &Curve<'_, H>, profile: &Profile<'_>, limit
         * 0.5;
     let u3 = if profile.w > 0.0 { 2.0 * u2 / profile.w } else { 0.0 };
     let (mut rv, mut ra, mut rj) = (0.0f32, 0.0f32, 0.0f32);
-    for j in 0..JOINTS {
-        let g = |x: &Joints<f32>| x.get(j).copied().unwrap_or(0.0);
+    for j in 0..J {
+        let g = |x: &[f32; J]| x.get(j).copied().unwrap_or(0.0);
         rv = rv.max(g(&q1) * u1 / g(&limits.velocity));
         ra = ra.max((g(&q1) * u2 + g(&q2) * u1 * u1) / g(&limits.acceleration));
         if jerk {

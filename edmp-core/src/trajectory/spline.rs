@@ -10,10 +10,8 @@
 //! The parameter `u` runs over `[0, spans]`, one unit per span; derivatives are per unit of `u`.
 
 use crate::error::Error;
-use crate::robot::JOINTS;
-use crate::robot::kinematics::Joints;
 
-/// Largest magnitude (rad) of a waypoint joint the timing accepts: far beyond any Panda joint,
+/// Largest magnitude (rad) of a waypoint joint the timing accepts: far beyond any arm's joint,
 /// small enough that every difference and product of the timing stays finite in `f32`.
 pub const MAX_JOINT_MAGNITUDE: f32 = 100.0;
 
@@ -26,28 +24,29 @@ pub enum Shape {
     Polyline,
 }
 
-/// A curve's position and its first three derivatives with respect to `u` at one parameter.
+/// A curve's position and its first three derivatives with respect to `u` at one parameter,
+/// for an arm with `J` joints.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CurvePoint {
+pub struct CurvePoint<const J: usize> {
     /// Joint positions (rad).
-    pub q: Joints<f32>,
+    pub q: [f32; J],
     /// dq/du (rad per span).
-    pub d1: Joints<f32>,
+    pub d1: [f32; J],
     /// d²q/du².
-    pub d2: Joints<f32>,
+    pub d2: [f32; J],
     /// d³q/du³ (constant on a span).
-    pub d3: Joints<f32>,
+    pub d3: [f32; J],
 }
 
-/// The curve of `shape` over borrowed waypoints.
+/// The curve of `shape` over `H` borrowed waypoints of `J` joints.
 #[derive(Clone, Copy, Debug)]
-pub struct Curve<'a, const H: usize> {
-    waypoints: &'a [Joints<f32>; H],
+pub struct Curve<'a, const H: usize, const J: usize> {
+    waypoints: &'a [[f32; J]; H],
     shape: Shape,
 }
 
 /// Checks every waypoint joint: finite, and within [`MAX_JOINT_MAGNITUDE`].
-pub fn validate_waypoints(waypoints: &[Joints<f32>]) -> Result<(), Error> {
+pub fn validate_waypoints<const J: usize>(waypoints: &[[f32; J]]) -> Result<(), Error> {
     for w in waypoints {
         for (j, v) in w.iter().enumerate() {
             if !v.is_finite() {
@@ -61,9 +60,9 @@ pub fn validate_waypoints(waypoints: &[Joints<f32>]) -> Result<(), Error> {
     Ok(())
 }
 
-impl<'a, const H: usize> Curve<'a, H> {
+impl<'a, const H: usize, const J: usize> Curve<'a, H, J> {
     /// The curve of `shape` through `waypoints` (validate them first: [`validate_waypoints`]).
-    pub const fn new(waypoints: &'a [Joints<f32>; H], shape: Shape) -> Self {
+    pub const fn new(waypoints: &'a [[f32; J]; H], shape: Shape) -> Self {
         Self { waypoints, shape }
     }
 
@@ -78,17 +77,17 @@ impl<'a, const H: usize> Curve<'a, H> {
     }
 
     /// Control point `k` (indices past either end repeat the end).
-    pub fn control(&self, k: usize) -> Joints<f32> {
+    pub fn control(&self, k: usize) -> [f32; J] {
         let w = match self.shape {
             Shape::Spline => k.saturating_sub(2),
             Shape::Polyline => k / 3,
         };
         let last = H.saturating_sub(1);
-        self.waypoints.get(w.min(last)).copied().unwrap_or([0.0; JOINTS])
+        self.waypoints.get(w.min(last)).copied().unwrap_or([0.0; J])
     }
 
     /// The four control points of span `i`.
-    pub fn span_points(&self, i: usize) -> [Joints<f32>; 4] {
+    pub fn span_points(&self, i: usize) -> [[f32; J]; 4] {
         core::array::from_fn(|k| self.control(i + k))
     }
 
@@ -101,7 +100,7 @@ impl<'a, const H: usize> Curve<'a, H> {
     }
 
     /// Position and derivatives at `u`.
-    pub fn eval(&self, u: f32) -> CurvePoint {
+    pub fn eval(&self, u: f32) -> CurvePoint<J> {
         let (i, s) = self.locate(u);
         eval_span(&self.span_points(i), s)
     }
@@ -124,14 +123,14 @@ impl<'a, const H: usize> Curve<'a, H> {
 
     /// Per-joint bounds on |q'|, |q''|, |q'''| over the whole curve: the largest first, second
     /// and third differences of the control points (the derivatives are B-splines over them).
-    pub fn derivative_bounds(&self) -> [Joints<f32>; 3] {
-        let mut out = [[0.0f32; JOINTS]; 3];
+    pub fn derivative_bounds(&self) -> [[f32; J]; 3] {
+        let mut out = [[0.0f32; J]; 3];
         let n = self.spans() + 3;
         for k in 0..n {
-            let p: [Joints<f32>; 4] = core::array::from_fn(|m| self.control(k + m));
+            let p: [[f32; J]; 4] = core::array::from_fn(|m| self.control(k + m));
             let [p0, p1, p2, p3] = p;
-            for j in 0..JOINTS {
-                let v = |q: &Joints<f32>| q.get(j).copied().unwrap_or(0.0);
+            for j in 0..J {
+                let v = |q: &[f32; J]| q.get(j).copied().unwrap_or(0.0);
                 let (a, b, c, d) = (v(&p0), v(&p1), v(&p2), v(&p3));
                 let diffs = [b - a, c - 2.0 * b + a, d - 3.0 * c + 3.0 * b - a];
                 for (o, dv) in out.iter_mut().zip(diffs) {
@@ -147,7 +146,7 @@ impl<'a, const H: usize> Curve<'a, H> {
 
 /// Position and derivatives on one span. Written in differences from the second control point
 /// so that equal control points give exactly that point (the ends, the polyline's waypoints).
-pub fn eval_span(p: &[Joints<f32>; 4], s: f32) -> CurvePoint {
+pub fn eval_span<const J: usize>(p: &[[f32; J]; 4], s: f32) -> CurvePoint<J> {
     let r = 1.0 - s;
     let (s2, s3) = (s * s, s * s * s);
     let b = [r * r * r / 6.0, (-3.0 * s3 + 3.0 * s2 + 3.0 * s + 1.0) / 6.0, s3 / 6.0];
@@ -157,12 +156,12 @@ pub fn eval_span(p: &[Joints<f32>; 4], s: f32) -> CurvePoint {
     let [p0, p1, p2, p3] = p;
     let mut out = CurvePoint {
         q: *p1,
-        d1: [0.0; JOINTS],
-        d2: [0.0; JOINTS],
-        d3: [0.0; JOINTS],
+        d1: [0.0; J],
+        d2: [0.0; J],
+        d3: [0.0; J],
     };
-    for j in 0..JOINTS {
-        let at = |q: &Joints<f32>| q.get(j).copied().unwrap_or(0.0);
+    for j in 0..J {
+        let at = |q: &[f32; J]| q.get(j).copied().unwrap_or(0.0);
         let base = at(p1);
         let d = [at(p0) - base, at(p2) - base, at(p3) - base];
         let dot = |w: &[f32; 3]| w[0] * d[0] + w[1] * d[1] + w[2] * d[2];
@@ -182,8 +181,8 @@ pub fn eval_span(p: &[Joints<f32>; 4], s: f32) -> CurvePoint {
     out
 }
 
-/// Rounding allowance (rad) added to [`deviation_bound`]: `f32` evaluation of Panda-range
-/// joints (|q| < 8 rad, a few ulps of 5e-7).
+/// Rounding allowance (rad) added to [`deviation_bound`]: `f32` evaluation of joints within a
+/// turn and a bit either way (|q| < 8 rad, every arm's range; a few ulps of 5e-7).
 pub const ROUNDING_ALLOWANCE: f32 = 1e-5;
 
 /// Largest max-norm distance (rad) from any point of the curve to the polyline, bounded
@@ -191,7 +190,7 @@ pub const ROUNDING_ALLOWANCE: f32 = 1e-5;
 /// `(1-s)³/6 Δ²P₀ + s³/6 Δ²P₁` (the spline reproduces linear functions), so it never exceeds the
 /// largest second difference of the control points over 6. The polyline shape is exact, up to
 /// [`ROUNDING_ALLOWANCE`], which both include.
-pub fn deviation_bound<const H: usize>(waypoints: &[Joints<f32>; H], shape: Shape) -> f32 {
+pub fn deviation_bound<const H: usize, const J: usize>(waypoints: &[[f32; J]; H], shape: Shape) -> f32 {
     match shape {
         Shape::Polyline => ROUNDING_ALLOWANCE,
         Shape::Spline => {
@@ -227,7 +226,7 @@ mod tests {
     use super::*;
     use std::vec::Vec;
 
-    fn wavy() -> [Joints<f32>; 12] {
+    fn wavy() -> [[f32; 7]; 12] {
         core::array::from_fn(|k| core::array::from_fn(|j| 0.3 * libm::sinf(0.5 * k as f32 + j as f32) + 0.1 * j as f32))
     }
 
@@ -285,7 +284,7 @@ mod tests {
 
     /// Max-norm distance from `p` to segment `a → b`, minimised over the segment parameter by
     /// a fine scan (an independent, slow oracle).
-    fn dist_to_polyline(p: &Joints<f32>, w: &[Joints<f32>]) -> f32 {
+    fn dist_to_polyline(p: &[f32; 7], w: &[[f32; 7]]) -> f32 {
         let mut best = f32::INFINITY;
         for s in w.windows(2) {
             for k in 0..=2000 {

@@ -12,7 +12,6 @@
 
 use super::limits::JointLimits;
 use super::spline::{Curve, eval_span};
-use crate::robot::JOINTS;
 
 /// Cap on `u̇²` (spans²/s²): where the path barely moves, nothing else bounds it. 1e6 means at
 /// most 1000 spans per second, far faster than any limit allows on a moving path.
@@ -31,9 +30,70 @@ struct Row {
     d: f32,
 }
 
-/// Acceleration rows at both ends of an interval (2 per joint each), the bound on `|ü|`, and
-/// the next point's set.
-const ROWS: usize = 4 * JOINTS + 4;
+/// The `(x, ü)` polygon of one interval: four acceleration rows per joint (both ends, both
+/// signs), then up to four more: the bound on `|ü|` and the next point's set. Rows per joint
+/// rather than one array of `4 J + 4`, which a generic `J` cannot size.
+struct Rows<const J: usize> {
+    joints: [[Row; 4]; J],
+    extra: [Row; 4],
+    extras: usize,
+}
+
+impl<const J: usize> Rows<J> {
+    /// The acceleration rows of interval `i` in `(x_i, ü_i)`: at its start, and at its end where
+    /// `x_{i+1} = x_i + 2Δu ü_i` (TOPP-RA's first-order interpolation scheme: without it the
+    /// speed may jump wherever `q' = 0` at a grid point, and the acceleration in between is
+    /// unbounded); and the bound on `|ü|` where there is one.
+    fn acceleration(a: &Point<J>, b: &Point<J>, du: f32, limits: &JointLimits<J>) -> Self {
+        let zero = Row { r: 0.0, p: 0.0, d: 0.0 };
+        let mut rows = Self {
+            joints: [[zero; 4]; J],
+            extra: [zero; 4],
+            extras: 0,
+        };
+        for (j, out) in rows.joints.iter_mut().enumerate() {
+            let g = |x: &[f32; J]| x.get(j).copied().unwrap_or(0.0);
+            let lim = g(&limits.acceleration);
+            let (r0, p0) = (g(&a.d1), g(&a.d2));
+            let p1 = g(&b.d2);
+            let r1 = g(&b.d1) + 2.0 * du * p1;
+            *out = [
+                Row { r: r0, p: p0, d: lim },
+                Row { r: -r0, p: -p0, d: lim },
+                Row { r: r1, p: p1, d: lim },
+                Row { r: -r1, p: -p1, d: lim },
+            ];
+        }
+        if a.acc_cap.is_finite() {
+            rows.push(Row {
+                r: 1.0,
+                p: 0.0,
+                d: a.acc_cap,
+            });
+            rows.push(Row {
+                r: -1.0,
+                p: 0.0,
+                d: a.acc_cap,
+            });
+        }
+        rows
+    }
+
+    fn push(&mut self, row: Row) {
+        if let Some(slot) = self.extra.get_mut(self.extras) {
+            *slot = row;
+            self.extras += 1;
+        }
+    }
+
+    /// Every row, in order: the joints' (joint by joint), then the others as pushed.
+    fn iter(&self) -> impl Iterator<Item = &Row> {
+        self.joints
+            .as_flattened()
+            .iter()
+            .chain(self.extra.get(..self.extras).unwrap_or(&[]))
+    }
+}
 
 /// Largest excess, as a fraction of the limit, of a joint's acceleration inside an interval over
 /// its values at the ends. On an interval `q̈_j` is a quadratic in `u` whose `u²` coefficient is
@@ -43,9 +103,9 @@ pub const INTERIOR_EXCESS: f32 = 0.05;
 
 /// What the passes need of the curve at one grid point.
 #[derive(Clone, Copy)]
-struct Point {
-    d1: [f32; JOINTS],
-    d2: [f32; JOINTS],
+struct Point<const J: usize> {
+    d1: [f32; J],
+    d2: [f32; J],
     cap: f32,
     /// Bound on `|ü|` over the interval that starts here ([`INTERIOR_EXCESS`]).
     acc_cap: f32,
@@ -53,14 +113,14 @@ struct Point {
 
 /// The curve's derivatives at grid point `i`, and the cap on `x` there: velocity, the state
 /// part of jerk (both spans meeting at a knot, when jerk counts), and [`X_CAP`].
-fn point<const H: usize>(
-    curve: &Curve<'_, H>,
+fn point<const H: usize, const J: usize>(
+    curve: &Curve<'_, H, J>,
     i: usize,
     m: usize,
-    limits: &JointLimits,
+    limits: &JointLimits<J>,
     jerk: bool,
     acc_cap: f32,
-) -> Point {
+) -> Point<J> {
     let u = i as f32 / m as f32;
     let p = curve.eval(u);
     let mut cap = X_CAP;
@@ -100,7 +160,7 @@ fn point<const H: usize>(
 }
 
 /// The [`INTERIOR_EXCESS`] bound on `|ü|` for third derivatives `d3`.
-fn interior_cap(d3: &[f32; JOINTS], m: usize, limits: &JointLimits) -> f32 {
+fn interior_cap<const J: usize>(d3: &[f32; J], m: usize, limits: &JointLimits<J>) -> f32 {
     let du = 1.0 / m as f32;
     let mut cap = f32::INFINITY;
     for (d, a) in d3.iter().zip(&limits.acceleration) {
@@ -115,54 +175,17 @@ fn interior_cap(d3: &[f32; JOINTS], m: usize, limits: &JointLimits) -> f32 {
 /// The same over the whole curve: for spans where the path stands still (repeated waypoints:
 /// `q' = q'' = q''' = 0`), so that the parameter's speed still changes gradually there and the
 /// filter's jerk where motion resumes stays bounded.
-fn global_cap<const H: usize>(curve: &Curve<'_, H>, m: usize, limits: &JointLimits) -> f32 {
+fn global_cap<const H: usize, const J: usize>(curve: &Curve<'_, H, J>, m: usize, limits: &JointLimits<J>) -> f32 {
     let [_, _, d3] = curve.derivative_bounds();
     interior_cap(&d3, m, limits)
 }
 
-/// The acceleration rows of interval `i` in `(x_i, ü_i)`: at its start, and at its end where
-/// `x_{i+1} = x_i + 2Δu ü_i` (TOPP-RA's first-order interpolation scheme: without it the speed
-/// may jump wherever `q' = 0` at a grid point, and the acceleration in between is unbounded).
-fn acceleration_rows(a: &Point, b: &Point, du: f32, limits: &JointLimits, rows: &mut [Row; ROWS]) -> usize {
-    let mut n = 0;
-    let mut push = |row: Row| {
-        if let Some(slot) = rows.get_mut(n) {
-            *slot = row;
-            n += 1;
-        }
-    };
-    for j in 0..JOINTS {
-        let g = |x: &[f32; JOINTS]| x.get(j).copied().unwrap_or(0.0);
-        let lim = g(&limits.acceleration);
-        let (r0, p0) = (g(&a.d1), g(&a.d2));
-        let p1 = g(&b.d2);
-        let r1 = g(&b.d1) + 2.0 * du * p1;
-        push(Row { r: r0, p: p0, d: lim });
-        push(Row { r: -r0, p: -p0, d: lim });
-        push(Row { r: r1, p: p1, d: lim });
-        push(Row { r: -r1, p: -p1, d: lim });
-    }
-    if a.acc_cap.is_finite() {
-        push(Row {
-            r: 1.0,
-            p: 0.0,
-            d: a.acc_cap,
-        });
-        push(Row {
-            r: -1.0,
-            p: 0.0,
-            d: a.acc_cap,
-        });
-    }
-    n
-}
-
 /// Fills `hi` and `lo` (indices `0..=k`) with the controllable sets of the grid `u_i = i/m`.
-pub(crate) fn backward<const H: usize>(
-    curve: &Curve<'_, H>,
+pub(crate) fn backward<const H: usize, const J: usize>(
+    curve: &Curve<'_, H, J>,
     m: usize,
     k: usize,
-    limits: &JointLimits,
+    limits: &JointLimits<J>,
     jerk: bool,
     hi: &mut [f32],
     lo: &mut [f32],
@@ -178,26 +201,17 @@ pub(crate) fn backward<const H: usize>(
         let here = point(curve, i, m, limits, jerk, cap);
         let mut x_hi = here.cap;
         let mut x_lo = 0.0f32;
-        let mut rows = [Row { r: 0.0, p: 0.0, d: 0.0 }; ROWS];
-        let mut n = acceleration_rows(&here, &next, du, limits, &mut rows);
-        for row in [
-            Row {
-                r: 2.0 * du,
-                p: 1.0,
-                d: next_hi,
-            },
-            Row {
-                r: -2.0 * du,
-                p: -1.0,
-                d: -next_lo,
-            },
-        ] {
-            if let Some(slot) = rows.get_mut(n) {
-                *slot = row;
-                n += 1;
-            }
-        }
-        let rows = rows.get(..n).unwrap_or(&[]);
+        let mut rows = Rows::acceleration(&here, &next, du, limits);
+        rows.push(Row {
+            r: 2.0 * du,
+            p: 1.0,
+            d: next_hi,
+        });
+        rows.push(Row {
+            r: -2.0 * du,
+            p: -1.0,
+            d: -next_lo,
+        });
         // Bound on x from one half-plane `px ≤ d` (no ü left).
         let mut apply = |p: f32, d: f32| {
             if p > 0.0 {
@@ -208,7 +222,7 @@ pub(crate) fn backward<const H: usize>(
                 x_hi = f32::NEG_INFINITY;
             }
         };
-        for up in rows {
+        for up in rows.iter() {
             if up.r == 0.0 {
                 apply(up.p, up.d);
             }
@@ -236,11 +250,11 @@ pub(crate) fn backward<const H: usize>(
 
 /// Greedy forward pass over the sets of [`backward`]: overwrites `hi` with the chosen `x`
 /// (`x_0 = 0`, `x_k = 0`).
-pub(crate) fn forward<const H: usize>(
-    curve: &Curve<'_, H>,
+pub(crate) fn forward<const H: usize, const J: usize>(
+    curve: &Curve<'_, H, J>,
     m: usize,
     k: usize,
-    limits: &JointLimits,
+    limits: &JointLimits<J>,
     jerk: bool,
     hi: &mut [f32],
     lo: &[f32],
@@ -254,10 +268,9 @@ pub(crate) fn forward<const H: usize>(
     let mut here = point(curve, 0, m, limits, jerk, cap);
     for i in 0..k {
         let next = point(curve, i + 1, m, limits, jerk, cap);
-        let mut rows = [Row { r: 0.0, p: 0.0, d: 0.0 }; ROWS];
-        let n = acceleration_rows(&here, &next, du, limits, &mut rows);
+        let rows = Rows::acceleration(&here, &next, du, limits);
         let mut acc_hi = f32::INFINITY;
-        for row in rows.get(..n).unwrap_or(&[]) {
+        for row in rows.iter() {
             if row.r > 0.0 {
                 acc_hi = acc_hi.min((row.d - row.p * x) / row.r);
             }
@@ -284,13 +297,13 @@ mod tests {
     use super::super::limits::Limits;
     use super::super::spline::Shape;
     use super::*;
-    use crate::robot::kinematics::Joints;
+    use crate::robot::PANDA;
 
     #[test]
     fn profile_starts_and_ends_at_rest_within_limits_at_the_grid() {
-        let w: [Joints<f32>; 6] = core::array::from_fn(|k| [0.2 * k as f32, -0.1 * k as f32, 0.0, -1.5, 0.3, 1.5, 0.1]);
+        let w: [[f32; 7]; 6] = core::array::from_fn(|k| [0.2 * k as f32, -0.1 * k as f32, 0.0, -1.5, 0.3, 1.5, 0.1]);
         let c = Curve::new(&w, Shape::Spline);
-        let l = Limits::DEFAULT.joint_limits().unwrap();
+        let l = Limits::DEFAULT.joint_limits(&PANDA).unwrap();
         let (m, k) = (8, 8 * c.spans());
         let (mut hi, mut lo) = ([0.0f32; 64], [0.0f32; 64]);
         backward(&c, m, k, &l, true, &mut hi, &mut lo);

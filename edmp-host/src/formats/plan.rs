@@ -11,10 +11,9 @@ use crate::planning::{Planned, ROWS};
 use edmp_core::cost::boxes::Inflation;
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::guidance::guides::Guide;
-use edmp_core::path::Path;
 use edmp_core::planner::{Plan, PlanConfig};
 use edmp_core::robot::kinematics::Joints;
-use edmp_core::robot::{JOINTS, PANDA};
+use edmp_core::robot::JOINTS;
 use serde_json::{Value, json};
 use std::time::Instant;
 
@@ -105,8 +104,8 @@ pub fn plan_document<const J: usize>(
 }
 
 /// Adds the `trajectory` field (and `timing_ms.trajectory`) to a plan document when the plan
-/// is free; `false` when it collides (a colliding path is not timed). The time law knows the
-/// Panda's limits only: another arm's problem is refused by name.
+/// is free, timed within the problem's arm's limits; `false` when it collides (a colliding path
+/// is not timed).
 pub fn add_trajectory<const J: usize>(
     doc: &mut serde_json::Value,
     problem: &Problem<J>,
@@ -114,19 +113,11 @@ pub fn add_trajectory<const J: usize>(
     config: &PlanConfig,
     request: &TimedRequest,
 ) -> Result<bool, Failure> {
-    if problem.robot.name != PANDA.name || J != JOINTS {
-        return Err(Failure::Input(format!(
-            "--timed: the time law knows the Panda's velocity, acceleration and jerk limits only, not the {}'s",
-            problem.robot.name
-        )));
-    }
     let Some(path) = plan.paths.get(plan.best).filter(|_| plan.is_free()) else {
         return Ok(false);
     };
-    // The Panda's path, row by row (J is the Panda's JOINTS here).
-    let path: Path = core::array::from_fn(|i| core::array::from_fn(|j| path[i].get(j).copied().unwrap_or(0.0)));
     let began = Instant::now();
-    doc["trajectory"] = trajectory_document(&problem.scene(), &path, &config.check, request)?;
+    doc["trajectory"] = trajectory_document(problem.robot, &problem.scene(), path, &config.check, request)?;
     doc["timing_ms"]["trajectory"] = json!(began.elapsed().as_secs_f64() * 1e3);
     Ok(true)
 }

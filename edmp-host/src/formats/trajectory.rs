@@ -3,12 +3,14 @@
 //!
 //! The core times the path (`edmp_core::trajectory`): a cubic B-spline over the waypoints,
 //! checked with the planner's checker (or the exact polyline when the spline touches
-//! anything), within Franka's velocity, acceleration and jerk limits times the user's scales,
-//! from rest to rest. Here it is sampled at the user's rate and written out.
+//! anything), within the arm's velocity, acceleration and jerk limits (its `Robot` table's)
+//! times the user's scales, from rest to rest. Here it is sampled at the user's rate and written
+//! out, under the arm's joint names.
 
 use crate::Failure;
 use edmp_core::collision::checker::CheckConfig;
-use edmp_core::path::Path;
+use edmp_core::path::{HORIZON, Path};
+use edmp_core::robot::Robot;
 use edmp_core::scene::Scene;
 use edmp_core::trajectory::{Limits, Shape, Timed, parameterize_checked};
 use serde_json::{Value, json};
@@ -19,16 +21,16 @@ pub const MAX_RATE: f64 = 1000.0;
 /// The `--timed` flags of `edmp-host plan`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct TimedArgs {
-    /// Add `trajectory`: the path timed within Franka's limits, from rest to rest.
+    /// Add `trajectory`: the path timed within the arm's limits, from rest to rest.
     #[arg(long)]
     pub timed: bool,
     /// Sample rate of the trajectory's points, Hz (at most 1000).
     #[arg(long, default_value_t = 100.0, requires = "timed")]
     pub rate: f64,
-    /// Fraction of Franka's velocity limits, in (0, 1].
+    /// Fraction of the arm's velocity limits, in (0, 1].
     #[arg(long, default_value_t = 1.0, requires = "timed")]
     pub velocity_scale: f32,
-    /// Fraction of Franka's acceleration and jerk limits, in (0, 1].
+    /// Fraction of the arm's acceleration and jerk limits, in (0, 1].
     #[arg(long, default_value_t = 1.0, requires = "timed")]
     pub acceleration_scale: f32,
     /// Time-optimal under the velocity and acceleration limits alone, the acceleration jumps
@@ -86,15 +88,17 @@ impl TimedArgs {
     }
 }
 
-/// The `trajectory` document of `path` (a path the planner's checker passed in `scene`).
-pub fn trajectory_document<const N: usize>(
+/// The `trajectory` document of `path`, a path of `robot` the planner's checker passed in
+/// `scene`: timed within `robot`'s limits, its points under `robot`'s joint names.
+pub fn trajectory_document<const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
-    path: &Path,
+    path: &Path<J>,
     check: &CheckConfig,
     request: &TimedRequest,
 ) -> Result<Value, Failure> {
-    let mut timed = Box::new(Timed::<{ edmp_core::trajectory::DEFAULT_GRID }>::new());
-    let shape = parameterize_checked(scene, path, &request.limits, check, &mut timed)
+    let mut timed = Box::new(Timed::<{ edmp_core::trajectory::DEFAULT_GRID }, HORIZON, J>::new());
+    let shape = parameterize_checked(robot, scene, path, &request.limits, check, &mut timed)
         .map_err(|e| Failure::Input(format!("time parameterization: {e}")))?;
     let duration = f64::from(timed.duration());
     // Every 1/rate seconds, and the last point exactly at the end.
@@ -108,15 +112,15 @@ pub fn trajectory_document<const N: usize>(
             };
             let p = timed.sample(time);
             json!({
-                "positions": p.positions,
-                "velocities": p.velocities,
-                "accelerations": p.accelerations,
+                "positions": p.positions.as_slice(),
+                "velocities": p.velocities.as_slice(),
+                "accelerations": p.accelerations.as_slice(),
                 "time_from_start": p.time,
             })
         })
         .collect();
     Ok(json!({
-        "joint_names": (1..=7).map(|j| format!("panda_joint{j}")).collect::<Vec<_>>(),
+        "joint_names": robot.joint_names.as_slice(),
         "points": points,
         "limits": {
             "velocity_scale": request.limits.velocity_scale,

@@ -318,7 +318,7 @@ fn plan_scene(
 #[inline(never)]
 fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed, surface: &mut WireSurface<PIECES, NODES>) -> Result<u64, Failure> {
     let (_, scene) = decode(bytes, surface)?;
-    parameterize_checked(&scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, timed).map_err(Failure::Plan)?;
+    parameterize_checked(&PANDA, &scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, timed).map_err(Failure::Plan)?;
     Ok(timed.fingerprint())
 }
 
