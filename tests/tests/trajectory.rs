@@ -1,7 +1,8 @@
 //! Time parameterization (`edmp_core::trajectory`) judged from the outside, in f64: on smooth
-//! and jagged paths, sampled at 1 kHz and 100 Hz, every reported velocity and acceleration and
-//! every finite difference (velocity and acceleration from positions, acceleration from
-//! velocities, jerk from accelerations) stays within Franka's limits times the scales; the
+//! and jagged paths of the Panda, and on planned paths of the iiwa 7 and the xArm 6, sampled at
+//! 1 kHz and 100 Hz, every reported velocity and acceleration and every finite difference
+//! (velocity and acceleration from positions, acceleration from velocities, jerk from
+//! accelerations) stays within the arm's limits (its `Robot` table's) times the scales; the
 //! trajectory starts and ends at rest at the ends; positions stay on the curve; bad input is a
 //! typed error; the same input gives the same bits.
 //!
@@ -12,12 +13,18 @@ use edmp_core::Error;
 use edmp_core::collision::checker::CheckConfig;
 use edmp_core::path::HORIZON;
 use edmp_core::rng::Rng;
+use edmp_core::guidance::guides::EDMP_GUIDES;
+use edmp_core::planner::PlanConfig;
+use edmp_core::prior::Network;
 use edmp_core::robot::kinematics::Joints;
+use edmp_core::robot::{PANDA, Robot};
 use edmp_core::scene::{Obstacle, Scene};
-use edmp_core::trajectory::limits::{ACCELERATION, JERK, VELOCITY};
 use edmp_core::trajectory::{
-    DEFAULT_GRID, Limits, Shape, Timed, check_curve, deviation_bound, parameterize, parameterize_checked,
+    DEFAULT_GRID, Limits, Shape, Timed, TimedPoint, check_curve, deviation_bound, parameterize, parameterize_checked,
 };
+use edmp_host::formats::json::parse_problem_for;
+use edmp_host::formats::trajectory::{TimedRequest, trajectory_document};
+use edmp_host::planning::plan_problem;
 use proptest::prelude::*;
 
 type Path = [Joints<f32>; HORIZON];
@@ -61,28 +68,29 @@ fn jagged(rng: &mut Rng, step: f32) -> Path {
     })
 }
 
-fn joint_limits(limits: &Limits) -> [[f64; 7]; 3] {
+/// `robot`'s limits times the scales, in f64.
+fn joint_limits<const J: usize>(robot: &Robot<f32, J>, limits: &Limits) -> [[f64; J]; 3] {
     let (v, a) = (f64::from(limits.velocity_scale), f64::from(limits.acceleration_scale));
     [
-        VELOCITY.map(|x| f64::from(x) * v),
-        ACCELERATION.map(|x| f64::from(x) * a),
-        JERK.map(|x| f64::from(x) * a),
+        robot.max_velocity.map(|x| f64::from(x) * v),
+        robot.max_acceleration.map(|x| f64::from(x) * a),
+        robot.max_jerk.map(|x| f64::from(x) * a),
     ]
 }
 
 /// Max-norm distance from `p` to the polyline `w`: per segment a convex function of the
 /// segment parameter, minimised by ternary search.
-fn distance_to_polyline(p: &[f64; 7], w: &Path) -> f64 {
+fn distance_to_polyline<const J: usize>(p: &[f64; J], w: &[[f32; J]; HORIZON]) -> f64 {
     let mut best = f64::INFINITY;
     for s in w.windows(2) {
         let (a, b) = (s[0].map(f64::from), s[1].map(f64::from));
         let f = |t: f64| {
-            (0..7)
+            (0..J)
                 .map(|j| (p[j] - (a[j] + t * (b[j] - a[j]))).abs())
                 .fold(0.0, f64::max)
         };
         // Cheap reject: the segment's box.
-        let gap = (0..7)
+        let gap = (0..J)
             .map(|j| (a[j].min(b[j]) - p[j]).max(p[j] - a[j].max(b[j])).max(0.0))
             .fold(0.0, f64::max);
         if gap >= best {
@@ -113,10 +121,17 @@ struct Worst {
     acceleration_at: (f32, &'static str),
 }
 
-/// Samples `timed` at `rate` Hz (and at its end) and asserts every limit, in f64. Finite
-/// differences carry f32 rounding: `noise(n)` is the error of an n-th difference of f32 values.
-fn verify(timed: &Traj, w: &Path, limits: &Limits, rate: f64) -> Worst {
-    let [vl, al, jl] = joint_limits(limits);
+/// Samples `timed`, a trajectory of `robot`, at `rate` Hz (and at its end) and asserts every
+/// limit of `robot`'s, in f64. Finite differences carry f32 rounding: `noise(n)` is the error of
+/// an n-th difference of f32 values.
+fn verify<const J: usize>(
+    robot: &Robot<f32, J>,
+    timed: &Timed<DEFAULT_GRID, HORIZON, J>,
+    w: &[[f32; J]; HORIZON],
+    limits: &Limits,
+    rate: f64,
+) -> Worst {
+    let [vl, al, jl] = joint_limits(robot, limits);
     let d = f64::from(timed.duration());
     let dt = 1.0 / rate;
     let n = (d * rate).floor() as usize;
@@ -129,11 +144,11 @@ fn verify(timed: &Traj, w: &Path, limits: &Limits, rate: f64) -> Worst {
     let last = pts.last().unwrap();
     assert_eq!(first.positions, w[0]);
     assert_eq!(last.positions, w[HORIZON - 1]);
-    assert_eq!(first.velocities, [0.0; 7]);
-    assert_eq!(last.velocities, [0.0; 7]);
-    assert_eq!(last.accelerations, [0.0; 7]);
+    assert_eq!(first.velocities, [0.0; J]);
+    assert_eq!(last.velocities, [0.0; J]);
+    assert_eq!(last.accelerations, [0.0; J]);
     if limits.jerk_limited {
-        assert_eq!(first.accelerations, [0.0; 7]);
+        assert_eq!(first.accelerations, [0.0; J]);
     }
     let tol = 1.0 + 1e-4;
     let eps = f64::from(f32::EPSILON);
@@ -151,7 +166,7 @@ fn verify(timed: &Traj, w: &Path, limits: &Limits, rate: f64) -> Worst {
             assert!(dev <= tolerance, "t {}: {dev} from the polyline > {tolerance}", p.time);
             worst.deviation = worst.deviation.max(dev);
         }
-        for j in 0..7 {
+        for j in 0..J {
             let (v, a) = (f64::from(p.velocities[j]), f64::from(p.accelerations[j]));
             assert!(v.is_finite() && a.is_finite() && q[j].is_finite());
             worst.velocity = worst.velocity.max(v.abs() / vl[j]);
@@ -162,13 +177,13 @@ fn verify(timed: &Traj, w: &Path, limits: &Limits, rate: f64) -> Worst {
         }
     }
     // Rounding of one f32 position: its own ulp, the time's (times speed), the parameter's.
-    let noise = |p: &edmp_core::trajectory::TimedPoint, j: usize| {
+    let noise = |p: &TimedPoint<J>, j: usize| {
         ulp(f64::from(p.positions[j])) + 2.0 * f64::from(p.velocities[j]).abs() * ulp(f64::from(p.time)) + 1e-6
     };
     for k in 1..pts.len() {
         let (a, b) = (&pts[k - 1], &pts[k]);
         let h = f64::from(b.time) - f64::from(a.time);
-        for j in 0..7 {
+        for j in 0..J {
             let (qa, qb) = (f64::from(a.positions[j]), f64::from(b.positions[j]));
             let (va, vb) = (f64::from(a.velocities[j]), f64::from(b.velocities[j]));
             let (aa, ab) = (f64::from(a.accelerations[j]), f64::from(b.accelerations[j]));
@@ -222,7 +237,7 @@ fn verify(timed: &Traj, w: &Path, limits: &Limits, rate: f64) -> Worst {
 
 fn timed(w: &Path, shape: Shape, limits: &Limits) -> Box<Traj> {
     let mut t = Box::new(Traj::new());
-    parameterize(w, shape, limits, &mut t).unwrap();
+    parameterize(&PANDA, w, shape, limits, &mut t).unwrap();
     t
 }
 
@@ -250,8 +265,8 @@ fn limits_hold_at_1khz_and_100hz_on_smooth_and_jagged_paths() {
         for limits in &scales {
             for shape in [Shape::Spline, Shape::Polyline] {
                 let t = timed(&w, shape, limits);
-                let fast = verify(&t, &w, limits, 1000.0);
-                let slow = verify(&t, &w, limits, 100.0);
+                let fast = verify(&PANDA, &t, &w, limits, 1000.0);
+                let slow = verify(&PANDA, &t, &w, limits, 100.0);
                 println!(
                     "case {case} {shape:?} {limits:?}: {:.3} s (scale {:.4}, window {:.4}), worst v {:.3} a {:.3} j {:.3}, 100 Hz a {:.3}, deviation {:.2e} of {:.2e}",
                     t.duration(),
@@ -333,7 +348,7 @@ fn bad_input_is_a_typed_error_and_leaves_an_empty_trajectory() {
         let mut w = good;
         w[17][joint] = bad;
         assert_eq!(
-            parameterize(&w, Shape::Spline, &Limits::DEFAULT, &mut t),
+            parameterize(&PANDA, &w, Shape::Spline, &Limits::DEFAULT, &mut t),
             Err(Error::NonFiniteJoint { joint: joint as u8 })
         );
         assert_eq!(t.duration(), 0.0);
@@ -342,7 +357,7 @@ fn bad_input_is_a_typed_error_and_leaves_an_empty_trajectory() {
     let mut w = good;
     w[3][6] = 1e6;
     assert_eq!(
-        parameterize(&w, Shape::Spline, &Limits::DEFAULT, &mut t),
+        parameterize(&PANDA, &w, Shape::Spline, &Limits::DEFAULT, &mut t),
         Err(Error::OutOfRange { joint: 6 })
     );
     for s in [0.0, -1.0, 1.5, f32::NAN, f32::INFINITY] {
@@ -350,20 +365,20 @@ fn bad_input_is_a_typed_error_and_leaves_an_empty_trajectory() {
             velocity_scale: s,
             ..Limits::DEFAULT
         };
-        assert_eq!(parameterize(&good, Shape::Spline, &l, &mut t), Err(Error::BadScale));
+        assert_eq!(parameterize(&PANDA, &good, Shape::Spline, &l, &mut t), Err(Error::BadScale));
         let l = Limits {
             acceleration_scale: s,
             ..Limits::DEFAULT
         };
-        assert_eq!(parameterize(&good, Shape::Polyline, &l, &mut t), Err(Error::BadScale));
+        assert_eq!(parameterize(&PANDA, &good, Shape::Polyline, &l, &mut t), Err(Error::BadScale));
     }
     let mut small = Box::new(Timed::<100, HORIZON>::new());
     assert_eq!(
-        parameterize(&good, Shape::Polyline, &Limits::DEFAULT, &mut small),
+        parameterize(&PANDA, &good, Shape::Polyline, &Limits::DEFAULT, &mut small),
         Err(Error::GridTooSmall)
     );
     // A smaller grid still works when it holds a point per span.
-    parameterize(&good, Shape::Spline, &Limits::DEFAULT, &mut small).unwrap();
+    parameterize(&PANDA, &good, Shape::Spline, &Limits::DEFAULT, &mut small).unwrap();
     assert_eq!(small.grid_points(), 52);
     // A scale so small that the trajectory would last for days.
     let l = Limits {
@@ -371,10 +386,10 @@ fn bad_input_is_a_typed_error_and_leaves_an_empty_trajectory() {
         acceleration_scale: 1e-6,
         jerk_limited: true,
     };
-    assert_eq!(parameterize(&good, Shape::Spline, &l, &mut t), Err(Error::Overflow));
+    assert_eq!(parameterize(&PANDA, &good, Shape::Spline, &l, &mut t), Err(Error::Overflow));
     // Huge but accepted values stay finite.
     let far: Path = core::array::from_fn(|k| [-99.0 + 198.0 * k as f32 / 49.0; 7]);
-    parameterize(&far, Shape::Polyline, &Limits::DEFAULT, &mut t).unwrap();
+    parameterize(&PANDA, &far, Shape::Polyline, &Limits::DEFAULT, &mut t).unwrap();
     assert!(t.duration().is_finite() && t.duration() > 0.0);
     for k in 0..=100 {
         let p = t.sample(t.duration() * k as f32 / 100.0);
@@ -393,7 +408,7 @@ fn still_and_nearly_still_paths_are_rest_trajectories() {
     let mut t = Box::new(Traj::new());
     let still: Path = [READY; HORIZON];
     for shape in [Shape::Spline, Shape::Polyline] {
-        parameterize(&still, shape, &Limits::DEFAULT, &mut t).unwrap();
+        parameterize(&PANDA, &still, shape, &Limits::DEFAULT, &mut t).unwrap();
         assert_eq!(t.duration(), 0.0);
         for time in [0.0, 1.0, -1.0, f32::NAN, f32::INFINITY] {
             let p = t.sample(time);
@@ -413,9 +428,9 @@ fn still_and_nearly_still_paths_are_rest_trajectories() {
         },
     ] {
         for shape in [Shape::Spline, Shape::Polyline] {
-            parameterize(&nearly, shape, &limits, &mut t).unwrap();
+            parameterize(&PANDA, &nearly, shape, &limits, &mut t).unwrap();
             assert!(t.duration() > 0.0 && t.duration() < 0.5, "{}", t.duration());
-            verify(&t, &nearly, &limits, 1000.0);
+            verify(&PANDA, &t, &nearly, &limits, 1000.0);
         }
     }
 }
@@ -453,7 +468,7 @@ fn the_curve_is_checked_densely_and_a_touching_spline_falls_back_to_the_polyline
     let w = smooth(&mut rng, 0.4);
     let cfg = CheckConfig::DEFAULT;
     let far = ball_scene([3.0, 3.0, 3.0], 0.1);
-    let r = check_curve(&far, &w, Shape::Spline, &cfg).unwrap();
+    let r = check_curve(&PANDA, &far, &w, Shape::Spline, &cfg).unwrap();
     assert!(r.free);
     // At least one state per 0.01 rad of the widest joint's travel along the curve.
     let travel: f32 = w
@@ -467,23 +482,109 @@ fn the_curve_is_checked_densely_and_a_touching_spline_falls_back_to_the_polyline
     );
     let mut t = Box::new(Traj::new());
     assert_eq!(
-        parameterize_checked(&far, &w, &Limits::DEFAULT, &cfg, &mut t),
+        parameterize_checked(&PANDA, &far, &w, &Limits::DEFAULT, &cfg, &mut t),
         Ok(Shape::Spline)
     );
     assert_eq!(t.shape(), Shape::Spline);
     // A ball around the whole arm: the spline touches it, the polyline is used.
     let wall = ball_scene([0.3, 0.0, 0.5], 0.3);
-    assert!(!check_curve(&wall, &w, Shape::Spline, &cfg).unwrap().free);
+    assert!(!check_curve(&PANDA, &wall, &w, Shape::Spline, &cfg).unwrap().free);
     assert_eq!(
-        parameterize_checked(&wall, &w, &Limits::DEFAULT, &cfg, &mut t),
+        parameterize_checked(&PANDA, &wall, &w, &Limits::DEFAULT, &cfg, &mut t),
         Ok(Shape::Polyline)
     );
     assert_eq!(t.shape(), Shape::Polyline);
     let mut bad = w;
     bad[5][1] = f32::NAN;
     assert_eq!(
-        check_curve(&far, &bad, Shape::Spline, &cfg),
+        check_curve(&PANDA, &far, &bad, Shape::Spline, &cfg),
         Err(Error::NonFiniteJoint { joint: 1 })
+    );
+}
+
+/// Plans `scene` (a benchmark problem of `robot`'s) with the shipped configuration and checks
+/// its timed path against `robot`'s own limits: the core's trajectory at 1 kHz and 100 Hz, full
+/// and scaled, and the host's `trajectory` document (its joint names and every written point).
+fn a_planned_path_keeps_the_arms_limits<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    network: Option<&'static Network<J>>,
+    scene: &str,
+) {
+    let network = network.expect("the arm's prior is compiled in");
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(scene);
+    let text = std::fs::read_to_string(&file).unwrap();
+    let problem = parse_problem_for(&text, file.parent().unwrap(), robot).unwrap();
+    let config = PlanConfig::DEFAULT;
+    let planned = plan_problem(network, &problem, &EDMP_GUIDES, &config, 0).unwrap();
+    assert!(planned.plan.is_free(), "{scene}: the plan collides");
+    let w = planned.plan.paths[planned.plan.best];
+    let scene_ = problem.scene();
+    let scaled = Limits {
+        velocity_scale: 0.5,
+        acceleration_scale: 0.3,
+        jerk_limited: true,
+    };
+    for limits in [Limits::DEFAULT, scaled] {
+        let mut t = Box::new(Timed::<DEFAULT_GRID, HORIZON, J>::new());
+        let shape = parameterize_checked(robot, &scene_, &w, &limits, &config.check, &mut t).unwrap();
+        assert_eq!(t.shape(), shape);
+        let fast = verify(robot, &t, &w, &limits, 1000.0);
+        let slow = verify(robot, &t, &w, &limits, 100.0);
+        println!(
+            "{} {scene} {shape:?} {limits:?}: {:.3} s (scale {:.4}, window {:.4}), worst v {:.3} a {:.3} j {:.3}, 100 Hz a {:.3}",
+            robot.name,
+            t.duration(),
+            t.scale(),
+            t.window(),
+            fast.velocity,
+            fast.acceleration,
+            fast.jerk,
+            slow.acceleration
+        );
+        // Time-optimal: some limit of this arm's is nearly reached.
+        assert!(fast.velocity.max(fast.acceleration).max(fast.jerk) > 0.8, "{fast:?}");
+    }
+    let request = TimedRequest::new(100.0, 1.0, 1.0).unwrap();
+    let doc = trajectory_document(robot, &scene_, &w, &config.check, &request).unwrap();
+    let names: Vec<&str> = doc["joint_names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    assert_eq!(names, robot.joint_names);
+    let [vl, al, _] = joint_limits(robot, &Limits::DEFAULT);
+    let points = doc["points"].as_array().unwrap();
+    assert!(points.len() > 10);
+    for p in points {
+        for (field, limit) in [("velocities", &vl), ("accelerations", &al)] {
+            let values = p[field].as_array().unwrap();
+            assert_eq!(values.len(), J);
+            for (j, v) in values.iter().enumerate() {
+                let v = v.as_f64().unwrap();
+                assert!(v.abs() <= limit[j] * (1.0 + 1e-4), "{field}[{j}] = {v} > {}", limit[j]);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_planned_path_of_the_iiwa7_keeps_its_limits() {
+    a_planned_path_keeps_the_arms_limits(
+        &edmp_core::robot::arms::iiwa7::ROBOT,
+        edmp_core::prior::arms::iiwa7::NETWORK,
+        "benchmarks/iiwa7/problems/tabletop/000.json",
+    );
+}
+
+#[test]
+fn a_planned_path_of_the_xarm6_keeps_its_limits() {
+    let robot = &edmp_core::robot::arms::xarm6::ROBOT;
+    assert_eq!(robot.joint_names.len(), 6);
+    a_planned_path_keeps_the_arms_limits(
+        robot,
+        edmp_core::prior::arms::xarm6::NETWORK,
+        "benchmarks/xarm6/problems/tabletop/000.json",
     );
 }
 
@@ -519,6 +620,6 @@ proptest! {
     #[test]
     fn limits_hold_on_random_paths_and_scales((w, limits, shape) in case()) {
         let t = timed(&w, shape, &limits);
-        verify(&t, &w, &limits, 250.0);
+        verify(&PANDA, &t, &w, &limits, 250.0);
     }
 }
