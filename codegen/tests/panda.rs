@@ -94,3 +94,23 @@ fn malformed_urdf_is_a_clear_error() {
     std::fs::remove_dir_all(&dir).ok();
     assert!(err.contains("root link"), "{err}");
 }
+
+#[test]
+fn the_time_law_limits_are_written_and_checked() {
+    let source = edmp_codegen::generate_robot(&panda_urdf(), panda())
+        .expect("the committed URDF reads")
+        .generated
+        .source;
+    // Franka's datasheet numbers, as the trajectory module had them.
+    assert!(source.contains("max_velocity: [2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61],"));
+    assert!(source.contains("max_acceleration: [15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0],"));
+    assert!(source.contains("max_jerk: [7500.0, 3750.0, 5000.0, 6250.0, 7500.0, 10000.0, 10000.0],"));
+    let mut short = *panda();
+    short.dynamics.jerk = &[1.0; 6];
+    let err = edmp_codegen::generate_robot(&panda_urdf(), &short).unwrap_err();
+    assert!(err.contains("dynamics.jerk has 6 values"), "{err}");
+    let mut zero = *panda();
+    zero.dynamics.acceleration = &[15.0, 7.5, 10.0, 0.0, 15.0, 20.0, 20.0];
+    let err = edmp_codegen::generate_robot(&panda_urdf(), &zero).unwrap_err();
+    assert!(err.contains("dynamics.acceleration[3] = 0"), "{err}");
+}

@@ -91,4 +91,53 @@ mod tests {
         assert_eq!(j.acceleration[1], 1.875);
         assert_eq!(j.jerk[6], 2500.0);
     }
+
+    /// The Panda's tables carry Franka's datasheet numbers exactly, so its timed plans keep
+    /// their bits.
+    #[test]
+    fn the_pandas_limits_are_frankas_datasheet() {
+        assert_eq!(PANDA.max_velocity, [2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61]);
+        assert_eq!(PANDA.max_acceleration, [15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0]);
+        assert_eq!(
+            PANDA.max_jerk,
+            [7500.0, 3750.0, 5000.0, 6250.0, 7500.0, 10000.0, 10000.0]
+        );
+    }
+
+    fn scaled_within<const J: usize>(robot: &Robot<f32, J>) {
+        let all = [robot.max_velocity, robot.max_acceleration, robot.max_jerk];
+        assert!(all.iter().flatten().all(|x| x.is_finite() && *x > 0.0), "{}", robot.name);
+        let l = Limits {
+            velocity_scale: 0.5,
+            acceleration_scale: 0.25,
+            jerk_limited: true,
+        };
+        let j = l.joint_limits(robot).unwrap();
+        for i in 0..J {
+            assert_eq!(j.velocity[i], robot.max_velocity[i] * 0.5);
+            assert_eq!(j.acceleration[i], robot.max_acceleration[i] * 0.25);
+            assert_eq!(j.jerk[i], robot.max_jerk[i] * 0.25);
+        }
+    }
+
+    #[test]
+    fn every_arms_limits_are_its_own_and_scale() {
+        scaled_within(&PANDA);
+        #[cfg(feature = "iiwa7")]
+        {
+            let iiwa = &crate::robot::arms::iiwa7::ROBOT;
+            scaled_within(iiwa);
+            // KUKA's datasheet axis speeds, °/s.
+            for (v, deg) in iiwa.max_velocity.iter().zip([98.0f32, 98.0, 100.0, 130.0, 140.0, 180.0, 180.0]) {
+                assert!((v - deg.to_radians()).abs() < 1e-6, "{v} vs {deg} °/s");
+            }
+        }
+        #[cfg(feature = "xarm6")]
+        {
+            let xarm = &crate::robot::arms::xarm6::ROBOT;
+            scaled_within(xarm);
+            // UFACTORY's datasheet: 180 °/s on every joint.
+            assert!(xarm.max_velocity.iter().all(|v| (v - core::f32::consts::PI).abs() < 1e-6));
+        }
+    }
 }
