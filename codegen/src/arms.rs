@@ -107,7 +107,15 @@ pub const ARMS: [ArmSpec; 3] = [
         // Flange at about (0.43, 0, 0.46) m, pointing down (q2 - q4 + q6 ≈ π).
         neutral: &[0.0, 0.2, 0.0, -2.0, 0.0, 0.95, 0.0],
         dynamics: Dynamics {
-            velocity: &[98.0 * DEG, 98.0 * DEG, 100.0 * DEG, 130.0 * DEG, 140.0 * DEG, 180.0 * DEG, 180.0 * DEG],
+            velocity: &[
+                98.0 * DEG,
+                98.0 * DEG,
+                100.0 * DEG,
+                130.0 * DEG,
+                140.0 * DEG,
+                180.0 * DEG,
+                180.0 * DEG,
+            ],
             velocity_source: "KUKA's LBR iiwa 7 R800 datasheet, axis speeds 98, 98, 100, 130, 140, 180, 180 °/s \
                               (the URDF's velocity=\"10\" is a placeholder)",
             // KUKA publishes no acceleration limit.

@@ -267,12 +267,20 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     let dynamics = &chain.arm.dynamics;
     for (field, unit, values, source) in [
         ("max_velocity", "rad/s", dynamics.velocity, dynamics.velocity_source),
-        ("max_acceleration", "rad/s²", dynamics.acceleration, dynamics.acceleration_source),
+        (
+            "max_acceleration",
+            "rad/s²",
+            dynamics.acceleration,
+            dynamics.acceleration_source,
+        ),
         ("max_jerk", "rad/s³", dynamics.jerk, dynamics.jerk_source),
     ] {
         wl(
             w,
-            &format!("            // Largest joint {} ({unit}): {source} (codegen's ARMS).", &field[4..]),
+            &format!(
+                "            // Largest joint {} ({unit}): {source} (codegen's ARMS).",
+                &field[4..]
+            ),
         );
         wl(w, &format!("            {field}: [{}],", limits(&|i| values[i])));
     }

@@ -51,7 +51,11 @@ pub fn generate_robot(urdf: &Path, arm: &arms::ArmSpec) -> Result<GeneratedArm, 
         ));
     }
     let d = &arm.dynamics;
-    for (what, values) in [("velocity", d.velocity), ("acceleration", d.acceleration), ("jerk", d.jerk)] {
+    for (what, values) in [
+        ("velocity", d.velocity),
+        ("acceleration", d.acceleration),
+        ("jerk", d.jerk),
+    ] {
         if values.len() != chain.joints.len() {
             return Err(format!(
                 "arm `{}`: dynamics.{what} has {} values, the URDF {} actuated joints",

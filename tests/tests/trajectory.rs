@@ -11,11 +11,11 @@
 
 use edmp_core::Error;
 use edmp_core::collision::checker::CheckConfig;
-use edmp_core::path::HORIZON;
-use edmp_core::rng::Rng;
 use edmp_core::guidance::guides::EDMP_GUIDES;
+use edmp_core::path::HORIZON;
 use edmp_core::planner::PlanConfig;
 use edmp_core::prior::Network;
+use edmp_core::rng::Rng;
 use edmp_core::robot::kinematics::Joints;
 use edmp_core::robot::{PANDA, Robot};
 use edmp_core::scene::{Obstacle, Scene};
@@ -365,12 +365,18 @@ fn bad_input_is_a_typed_error_and_leaves_an_empty_trajectory() {
             velocity_scale: s,
             ..Limits::DEFAULT
         };
-        assert_eq!(parameterize(&PANDA, &good, Shape::Spline, &l, &mut t), Err(Error::BadScale));
+        assert_eq!(
+            parameterize(&PANDA, &good, Shape::Spline, &l, &mut t),
+            Err(Error::BadScale)
+        );
         let l = Limits {
             acceleration_scale: s,
             ..Limits::DEFAULT
         };
-        assert_eq!(parameterize(&PANDA, &good, Shape::Polyline, &l, &mut t), Err(Error::BadScale));
+        assert_eq!(
+            parameterize(&PANDA, &good, Shape::Polyline, &l, &mut t),
+            Err(Error::BadScale)
+        );
     }
     let mut small = Box::new(Timed::<100, HORIZON>::new());
     assert_eq!(
@@ -386,7 +392,10 @@ fn bad_input_is_a_typed_error_and_leaves_an_empty_trajectory() {
         acceleration_scale: 1e-6,
         jerk_limited: true,
     };
-    assert_eq!(parameterize(&PANDA, &good, Shape::Spline, &l, &mut t), Err(Error::Overflow));
+    assert_eq!(
+        parameterize(&PANDA, &good, Shape::Spline, &l, &mut t),
+        Err(Error::Overflow)
+    );
     // Huge but accepted values stay finite.
     let far: Path = core::array::from_fn(|k| [-99.0 + 198.0 * k as f32 / 49.0; 7]);
     parameterize(&PANDA, &far, Shape::Polyline, &Limits::DEFAULT, &mut t).unwrap();

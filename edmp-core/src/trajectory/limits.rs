@@ -106,7 +106,11 @@ mod tests {
 
     fn scaled_within<const J: usize>(robot: &Robot<f32, J>) {
         let all = [robot.max_velocity, robot.max_acceleration, robot.max_jerk];
-        assert!(all.iter().flatten().all(|x| x.is_finite() && *x > 0.0), "{}", robot.name);
+        assert!(
+            all.iter().flatten().all(|x| x.is_finite() && *x > 0.0),
+            "{}",
+            robot.name
+        );
         let l = Limits {
             velocity_scale: 0.5,
             acceleration_scale: 0.25,
@@ -128,7 +132,11 @@ mod tests {
             let iiwa = &crate::robot::arms::iiwa7::ROBOT;
             scaled_within(iiwa);
             // KUKA's datasheet axis speeds, °/s.
-            for (v, deg) in iiwa.max_velocity.iter().zip([98.0f32, 98.0, 100.0, 130.0, 140.0, 180.0, 180.0]) {
+            for (v, deg) in iiwa
+                .max_velocity
+                .iter()
+                .zip([98.0f32, 98.0, 100.0, 130.0, 140.0, 180.0, 180.0])
+            {
                 assert!((v - deg.to_radians()).abs() < 1e-6, "{v} vs {deg} °/s");
             }
         }
@@ -137,7 +145,11 @@ mod tests {
             let xarm = &crate::robot::arms::xarm6::ROBOT;
             scaled_within(xarm);
             // UFACTORY's datasheet: 180 °/s on every joint.
-            assert!(xarm.max_velocity.iter().all(|v| (v - core::f32::consts::PI).abs() < 1e-6));
+            assert!(
+                xarm.max_velocity
+                    .iter()
+                    .all(|v| (v - core::f32::consts::PI).abs() < 1e-6)
+            );
         }
     }
 }

@@ -353,7 +353,12 @@ fn fill<const N: usize, const H: usize, const J: usize>(
 
 /// Largest ratio of demand to limit at `τ` (velocity as is, acceleration under a square root,
 /// jerk under a cube root: each is what a time scale divides out).
-fn demand<const H: usize, const J: usize>(curve: &Curve<'_, H, J>, law: Law, limits: &JointLimits<J>, jerk: bool) -> f32 {
+fn demand<const H: usize, const J: usize>(
+    curve: &Curve<'_, H, J>,
+    law: Law,
+    limits: &JointLimits<J>,
+    jerk: bool,
+) -> f32 {
     let p = curve.eval(law.u);
     let (mut rv, mut ra, mut rj) = (0.0f32, 0.0f32, 0.0f32);
     for j in 0..J {

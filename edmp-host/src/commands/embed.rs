@@ -223,8 +223,15 @@ pub fn time_like_firmware(bytes: &[u8], plan: &Plan<ROWS>) -> Result<Option<u64>
         decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
     let scene: Scene<MAX_OBSTACLES> = problem.to_scene_with(&decoded).map_err(|e| e.to_string())?;
     let mut timed: Box<Timed> = Box::new(Timed::new());
-    parameterize_checked(&PANDA, &scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, &mut timed)
-        .map_err(|e| format!("time parameterization: {e}"))?;
+    parameterize_checked(
+        &PANDA,
+        &scene,
+        path,
+        &Limits::DEFAULT,
+        &PlanConfig::DEFAULT.check,
+        &mut timed,
+    )
+    .map_err(|e| format!("time parameterization: {e}"))?;
     Ok(Some(timed.fingerprint()))
 }
 

@@ -12,8 +12,8 @@ use edmp_core::cost::boxes::Inflation;
 use edmp_core::cost::{CostConfig, CostKind, trajectory_cost};
 use edmp_core::guidance::guides::Guide;
 use edmp_core::planner::{Plan, PlanConfig};
-use edmp_core::robot::kinematics::Joints;
 use edmp_core::robot::JOINTS;
+use edmp_core::robot::kinematics::Joints;
 use serde_json::{Value, json};
 use std::time::Instant;
 
