@@ -8,18 +8,21 @@
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::path::HORIZON;
 use edmp_core::planner::{Judging, PlanConfig};
-use edmp_core::robot::{JOINT_NAMES, JOINTS};
+use edmp_core::prior::Network;
+use edmp_core::robot::{JOINT_NAMES, JOINTS, Robot};
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;
-use edmp_host::formats::json::{Goal, Problem, describe, joint_goal, parse_problem};
+use edmp_host::formats::json::{Goal, Problem, describe, joint_goal, parse_problem, parse_problem_for, scene_arm};
 use edmp_host::formats::plan::{add_trajectory, parse_plan, plan_document};
 use edmp_host::formats::trajectory::TimedRequest;
 use edmp_host::planning::{chosen_guides, plan_problem};
+use edmp_host::with_arm;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use serde_json::{Value, json};
+use std::path::Path;
 use std::time::Instant;
 
 create_exception!(
@@ -45,22 +48,31 @@ fn failure(e: Failure) -> PyErr {
     }
 }
 
+/// A Panda's scene (the functions that run the Panda alone: another arm is refused by name).
 fn parse(text: &str) -> PyResult<Problem> {
     parse_problem(text).map_err(scene_error)
+}
+
+/// A scene for `robot`; file paths in it are absolute (`Scene.from_file` made them so).
+fn parse_for<const J: usize>(text: &str, robot: &'static Robot<f32, J>) -> PyResult<Problem<J>> {
+    parse_problem_for(text, Path::new("."), robot).map_err(scene_error)
 }
 
 fn to_json(v: &Value) -> PyResult<String> {
     serde_json::to_string(v).map_err(|e| PlanError::new_err(e.to_string()))
 }
 
-/// Validates an `edmp-scene/1` document (JSON text); raises `SceneError` naming the field.
+/// Validates an `edmp-scene/1` document (JSON text) for the arm it names; raises `SceneError`
+/// naming the field.
 #[pyfunction]
 fn validate(scene: &str) -> PyResult<()> {
-    parse(scene).map(|_| ())
+    let arm = scene_arm(scene).map_err(scene_error)?;
+    with_arm!(arm, robot => parse_for(scene, robot).map(|_| ()))
 }
 
-/// Plans with the shipped configuration and returns the `edmp-plan/1` document as JSON text;
-/// `timed` adds the `trajectory` field as `edmp-host plan --timed` does (free plans only).
+/// Plans for the arm the scene names with the shipped configuration and returns the
+/// `edmp-plan/1` document as JSON text; `timed` adds the `trajectory` field as `edmp-host plan
+/// --timed` does (free plans only).
 #[pyfunction]
 #[pyo3(signature = (scene, seed = 0, candidates = false, timed = false, rate = 100.0, velocity_scale = 1.0, acceleration_scale = 1.0))]
 #[allow(clippy::too_many_arguments)]
@@ -74,7 +86,7 @@ fn plan(
     velocity_scale: f32,
     acceleration_scale: f32,
 ) -> PyResult<String> {
-    let problem = parse(scene)?;
+    let arm = scene_arm(scene).map_err(scene_error)?;
     // Validated before planning, as the CLI does: a bad scale is a ValueError, nothing runs.
     let request = if timed {
         Some(
@@ -90,6 +102,38 @@ fn plan(
     } else {
         None
     };
+    let options = Options {
+        seed,
+        candidates,
+        request,
+    };
+    // `with_arm!` returns the error of an arm without a trained prior from this closure.
+    let on_arm = || -> Result<PyResult<String>, String> {
+        Ok(with_arm!(arm, robot, network => plan_for(py, scene, robot, network, &options)))
+    };
+    on_arm().map_err(PlanError::new_err)?
+}
+
+/// What `plan` asks beyond the scene.
+struct Options {
+    seed: u64,
+    candidates: bool,
+    request: Option<TimedRequest>,
+}
+
+fn plan_for<const J: usize>(
+    py: Python<'_>,
+    scene: &str,
+    robot: &'static Robot<f32, J>,
+    network: &'static Network<J>,
+    options: &Options,
+) -> PyResult<String> {
+    let problem = parse_for(scene, robot)?;
+    let Options {
+        seed,
+        candidates,
+        ref request,
+    } = *options;
     let doc = py.detach(move || -> Result<Value, Failure> {
         let began = Instant::now();
         let guides = chosen_guides(&[])?;
@@ -100,10 +144,10 @@ fn plan(
             waves: if candidates { 1 } else { PlanConfig::DEFAULT.waves },
             ..PlanConfig::DEFAULT
         };
-        let planned = plan_problem(edmp_core::prior::PANDA, &problem, &guides, &config, seed)?;
+        let planned = plan_problem(network, &problem, &guides, &config, seed)?;
         let total_ms = began.elapsed().as_secs_f64() * 1e3;
         let mut doc = plan_document(&problem, &planned, &guides, &config, seed, candidates, total_ms)?;
-        if let Some(request) = &request {
+        if let Some(request) = request {
             add_trajectory(&mut doc, &problem, &planned.plan, &config, request)?;
         }
         Ok(doc)

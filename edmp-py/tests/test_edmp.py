@@ -504,3 +504,29 @@ def test_a_depth_image_of_the_wall_plans_like_the_wall(wall: edmp.Scene) -> None
     np.testing.assert_allclose(*(r[np.lexsort(r.T)] for r in rows), atol=1e-6)
     scene = _without_the_wall(wall).add_points(points, radius=0.0075)
     _blocks_the_straight_motion_and_plans_around(scene, 3)
+
+
+@pytest.mark.parametrize("robot, joints", [("xarm6", 6), ("iiwa7", 7)])
+def test_another_arms_scene_plans_with_its_joints_and_is_the_cli_document(robot: str, joints: int) -> None:
+    path = ROOT / "benchmarks" / robot / "problems" / "tabletop" / "000.json"
+    scene = edmp.Scene.from_file(path)
+    assert scene.robot == robot and scene.start.shape == (joints,)
+    p = edmp.plan(scene, seed=0, timed=True)
+    assert p.success and p.waypoints.shape == (50, joints)
+    np.testing.assert_allclose(p.waypoints[0], scene.start, atol=1e-6)
+    np.testing.assert_allclose(p.waypoints[-1], scene.goal, atol=1e-6)
+    assert p.trajectory is not None and p.trajectory["positions"].shape[1] == joints
+    assert len(p.trajectory["joint_names"]) == joints
+    if HOST:
+        out = subprocess.run([HOST, "plan", str(path), "--timed"], check=True, capture_output=True, text=True)
+        cli = json.loads(out.stdout)
+        ours = dict(p.document)
+        for doc in (cli, ours):
+            doc.pop("timing_ms")
+        assert ours == cli
+    bad = scene.to_dict()
+    bad["start"] = bad["start"] + [0.0]
+    with pytest.raises(edmp.SceneError, match=f"start: expected {joints} numbers, found {joints + 1}"):
+        edmp.Scene.from_dict(bad)
+    with pytest.raises(edmp.SceneError, match=f'robot: "{robot}": this command runs the panda only'):
+        edmp.ik(scene, [0.4, 0.0, 0.4], [0.0, 1.0, 0.0, 0.0])

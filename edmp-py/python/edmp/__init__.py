@@ -1,4 +1,4 @@
-"""EDMP motion planning for the Franka Panda, from Python.
+"""EDMP motion planning for the Franka Panda, the KUKA LBR iiwa 7 and the UFACTORY xArm 6, from Python.
 
 The planner, kinematics, checker and IK are edmp-rs's (Rust, ``edmp._edmp``); this module is
 the typed, numpy-facing API over them. Scenes are ``edmp-scene/1`` documents read by the same
@@ -10,6 +10,10 @@ CLI's ``edmp-plan/1`` document, parsed.
 >>> plan = edmp.plan(scene, seed=0)
 >>> plan.status, plan.waypoints.shape
 ('success', (50, 7))
+
+A scene names its arm in ``robot`` (``"panda"`` when absent, ``"iiwa7"``, ``"xarm6"``); joint
+vectors then have that arm's joint count (:attr:`Scene.robot`). :func:`plan` plans for every
+arm; :func:`fk`, :func:`check`, :func:`ik`, :func:`import_moveit` and the viewer run the Panda.
 """
 
 from __future__ import annotations
@@ -156,13 +160,18 @@ class Scene:
             raise SceneError(f"{os.fspath(path)}: {e}") from None
 
     @property
+    def robot(self) -> str:
+        """The arm the scene is for: ``"panda"`` (the field absent), ``"iiwa7"`` or ``"xarm6"``."""
+        return str(self._doc.get("robot", "panda"))
+
+    @property
     def start(self) -> Array:
-        """The start configuration, shape ``(7,)``."""
+        """The start configuration, shape ``(J,)``: the arm's joints (7 for the Panda)."""
         return np.asarray(self._doc["start"], dtype=np.float64)
 
     @property
     def goal(self) -> Union[Array, Pose]:
-        """The goal: joints, shape ``(7,)``, or a TCP :class:`Pose` (solved by IK when planning)."""
+        """The goal: joints, shape ``(J,)``, or a TCP :class:`Pose` (solved by IK when planning)."""
         goal = self._doc["goal"]
         if "joints" in goal:
             return np.asarray(goal["joints"], dtype=np.float64)
@@ -194,7 +203,7 @@ class Scene:
     def with_goal(self, joints: ArrayLike) -> "Scene":
         """The same scene with a joint goal."""
         doc = self.to_dict()
-        doc["goal"] = {"joints": _vector(joints, 7, "joints")}
+        doc["goal"] = {"joints": _vector(joints, len(self._doc["start"]), "joints")}
         return Scene(doc)
 
     def add_points(self, points: ArrayLike, radius: float, filter_robot: Optional[float] = None) -> "Scene":
@@ -291,7 +300,7 @@ class Plan:
     status: str
     """``"success"`` (passed the exact checker) or ``"collision"`` (least colliding returned)."""
     waypoints: Array
-    """The chosen trajectory, shape ``(50, 7)``."""
+    """The chosen trajectory, shape ``(50, J)`` (``J`` the arm's joints: 7 for the Panda)."""
     guide: int
     stage: str
     """Which stage won: ``diffusion``, ``reseeded``, ``search`` or ``none``."""
@@ -353,7 +362,7 @@ def _trajectory(t: Optional[Mapping[str, Any]]) -> Optional[dict[str, Any]]:
     out = {k: v for k, v in t.items() if k != "points"}
     points = t["points"]
     for key in ("positions", "velocities", "accelerations"):
-        out[key] = np.asarray([p[key] for p in points], dtype=np.float64).reshape(-1, 7)
+        out[key] = np.asarray([p[key] for p in points], dtype=np.float64).reshape(len(points), -1)
     out["time_from_start"] = np.asarray([p["time_from_start"] for p in points], dtype=np.float64)
     return out
 
@@ -367,16 +376,16 @@ def plan(
     velocity_scale: float = 1.0,
     acceleration_scale: float = 1.0,
 ) -> Plan:
-    """Plans with EDMP (the shipped configuration, as ``edmp-host plan``).
+    """Plans with EDMP for the scene's arm (the shipped configuration, as ``edmp-host plan``).
 
     ``candidates=True`` adds every trajectory of the ensemble: all 12 guides then run as one
     batch, as EDMP (without it the guides run in waves that stop at the first free candidate,
     so the winner may differ; ``edmp-host plan --candidates`` does the same). ``timed=True`` adds
-    ``Plan.trajectory``, as ``edmp-host plan --timed``: the path timed within Franka's velocity,
+    ``Plan.trajectory``, as ``edmp-host plan --timed``: the path timed within the arm's velocity,
     acceleration and jerk limits times ``velocity_scale`` / ``acceleration_scale`` (each in
     (0, 1], else ``ValueError``), from rest to rest, sampled at ``rate`` Hz (at most 1000); a
     dict shaped like ROS ``JointTrajectory`` whose ``positions``, ``velocities``,
-    ``accelerations`` are ``(n, 7)`` arrays and ``time_from_start`` an ``(n,)`` array. A colliding
+    ``accelerations`` are ``(n, J)`` arrays and ``time_from_start`` an ``(n,)`` array. A colliding
     plan is not timed (``trajectory`` is ``None``). The GIL is released while planning. Raises
     :class:`SceneError` for bad input and :class:`PlanError` when the core refuses the problem
     (for example an unreachable pose goal). A plan with ``status == "collision"`` is returned,
