@@ -23,6 +23,15 @@ pub fn sqrt(x: f32) -> f32 {
     libm::sqrtf(x)
 }
 
+/// `x` limited to `[lo, hi]`: `f32::clamp`'s bits where `lo <= hi` (NaN stays NaN), without
+/// its assertion, whose panic path a firmware would link when the bounds are an arm's table
+/// the compiler cannot see (`lo > hi` gives `hi`).
+#[inline]
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    let x = if x < lo { lo } else { x };
+    if x > hi { hi } else { x }
+}
+
 /// A lower bound on `√x` within 0.1 % of it, without `libm::sqrtf`, whose legacy-SSE `sqrtss`
 /// stalls among the AVX code around it on x86-64-v3 (`perf`: the balls' gaps were a tenth of a
 /// global-stage plan's time): a first guess from the bits, one Newton step (which lands at most

@@ -141,9 +141,17 @@ pub fn trajectory_cost<const H: usize, const N: usize, const J: usize>(
                     },
                 );
                 let half = &body.half_extents;
-                let (bb, bc) = (Solid::cuboid(&kb.boxes[b], half), Solid::cuboid(&kc.boxes[b], half));
-                let centers = [&kb.boxes[b].translation, &kc.boxes[b].translation];
-                segment([&hb, &hc], Some([&bb, &bc]), frame, centers, radius[b]);
+                let (Some(box_b), Some(box_c), Some(&r)) = (kb.boxes.get(b), kc.boxes.get(b), radius.get(b)) else {
+                    continue;
+                };
+                let (bb, bc) = (Solid::cuboid(box_b, half), Solid::cuboid(box_c, half));
+                segment(
+                    [&hb, &hc],
+                    Some([&bb, &bc]),
+                    frame,
+                    [&box_b.translation, &box_c.translation],
+                    r,
+                );
             }
             if let Some(h) = scene.held() {
                 let (pb, pc) = (

@@ -241,7 +241,8 @@ fn step_rows<const H: usize, const N: usize, const J: usize>(
         let mut norm2 = 0.0f32;
         let mut cost = 0.0f32;
         for (r, (row, grad)) in rows.iter().zip(grads.iter_mut()).enumerate() {
-            let clipped = row.map(|q| core::array::from_fn(|j| q[j].clamp(robot.hard_lower[j], robot.hard_upper[j])));
+            let clipped = row
+                .map(|q| core::array::from_fn(|j| crate::float::clamp(q[j], robot.hard_lower[j], robot.hard_upper[j])));
             cost += trajectory_cost_memo(robot, scene, &clipped, &config, Some(grad), memos.get_mut(r))?;
             norm2 += grad[1..H - 1].iter().flatten().map(|g| g * g).sum::<f32>();
         }

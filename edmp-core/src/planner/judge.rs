@@ -74,7 +74,7 @@ pub(crate) fn clamp_for_judging<const J: usize>(
 ) {
     for q in x.iter_mut() {
         for (j, v) in q.iter_mut().enumerate() {
-            *v = v.clamp(robot.soft_lower[j], robot.soft_upper[j]);
+            *v = crate::float::clamp(*v, robot.soft_lower[j], robot.soft_upper[j]);
         }
     }
     x[0] = *start;

@@ -1,6 +1,8 @@
 //! The network's layer types, as the generated weight table (`weights.rs`) lays them out and
 //! the forward pass (`net.rs`) reads them: int8 weights with one f32 scale per output channel.
 
+use super::weights::LEVELS;
+
 /// Keeps the weight blob at a 16-byte boundary (SIMD loads on the target).
 #[repr(C, align(16))]
 pub(crate) struct Aligned<B: ?Sized>(pub(crate) B);
@@ -63,10 +65,10 @@ pub(crate) struct Up {
 pub(crate) struct Net {
     pub(crate) time_in: Linear,
     pub(crate) time_out: Linear,
-    pub(crate) down: &'static [Down],
+    pub(crate) down: &'static [Down; LEVELS],
     pub(crate) mid0: ResBlock,
     pub(crate) mid1: ResBlock,
-    pub(crate) up: &'static [Up],
+    pub(crate) up: &'static [Up; LEVELS - 1],
     pub(crate) final_block: ConvBlock,
     pub(crate) out: Conv,
 }

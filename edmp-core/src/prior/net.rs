@@ -377,18 +377,9 @@ fn forward<const J: usize, const C: usize>(
             skips[skip_offset..skip_offset + n].copy_from_slice(&x_buf[..n]);
             skip_offset += n;
         }
-        if let Some(sample) = &level.sample {
-            conv_down(
-                sample,
-                x_buf,
-                lay,
-                y_buf,
-                Layout {
-                    batch,
-                    len: LENGTHS[i + 1],
-                },
-                wbuf,
-            );
+        // Every level but the deepest samples down (the build checks the table).
+        if let (Some(sample), Some(&next)) = (&level.sample, LENGTHS.get(i + 1)) {
+            conv_down(sample, x_buf, lay, y_buf, Layout { batch, len: next }, wbuf);
             core::mem::swap(&mut x_buf, &mut y_buf);
         }
     }
@@ -407,7 +398,7 @@ fn forward<const J: usize, const C: usize>(
         // Concatenate [x, skip_i] on channels: the skip's rows follow x's.
         let n = channels * lay.row();
         skip_offset -= n;
-        x_buf[n..2 * n].copy_from_slice(&skips[skip_offset..skip_offset + n]);
+        copy(x_buf.get_mut(n..2 * n), skips.get(skip_offset..skip_offset + n));
         res_block(&level.res0, x_buf, lay, temb, h_buf, y_buf, wbuf);
         core::mem::swap(&mut x_buf, &mut y_buf);
         res_block(&level.res1, x_buf, lay, temb, h_buf, y_buf, wbuf);
@@ -427,7 +418,7 @@ fn forward<const J: usize, const C: usize>(
     }
     if TOP_SKIP {
         let n = channels * top.row();
-        x_buf[n..2 * n].copy_from_slice(&skips[..n]);
+        copy(x_buf.get_mut(n..2 * n), skips.get(..n));
     }
     conv_block(&net.final_block, x_buf, top, y_buf, wbuf);
     conv_same(&net.out, y_buf, top, h_buf, Accumulate::Overwrite, wbuf);
@@ -436,6 +427,17 @@ fn forward<const J: usize, const C: usize>(
             for (j, v) in waypoint.iter_mut().enumerate() {
                 *v = h_buf[top.at(j, b, l)];
             }
+        }
+    }
+}
+
+/// `dst = src` where both ranges exist (they do: the build checks every network's shapes); the
+/// channel counts come from the arm's network table, which the compiler cannot see, so a
+/// slice copy would link a panic path.
+fn copy(dst: Option<&mut [f32]>, src: Option<&[f32]>) {
+    if let (Some(dst), Some(src)) = (dst, src) {
+        for (d, s) in dst.iter_mut().zip(src) {
+            *d = *s;
         }
     }
 }

@@ -148,7 +148,7 @@ fn start<const J: usize>(robot: &Robot<f32, J>, n: u16, preferred: &[f32; J]) ->
 }
 
 fn clamp<const J: usize>(robot: &Robot<f32, J>, q: &[f32; J]) -> [f32; J] {
-    core::array::from_fn(|j| q[j].clamp(robot.soft_lower[j], robot.soft_upper[j]))
+    core::array::from_fn(|j| crate::float::clamp(q[j], robot.soft_lower[j], robot.soft_upper[j]))
 }
 
 fn valid_target(target: &Pose<f32>) -> bool {
