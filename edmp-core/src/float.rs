@@ -46,3 +46,27 @@ pub fn sqrt_below(x: f32) -> f32 {
     let newton = 0.5 * (guess + x / guess);
     newton * 0.999
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clamp_has_f32_clamps_bits_and_never_panics() {
+        let specials = [0.0f32, -0.0, 1.0, -1.0, 2.8973, -2.8973, 1e-30, f32::INFINITY, f32::NEG_INFINITY];
+        let mut rng = crate::rng::Rng::new(7);
+        let values = specials
+            .into_iter()
+            .chain((0..2000).map(|_| rng.uniform_f32(-4.0, 4.0)));
+        let values: heapless::Vec<f32, 2048> = values.collect();
+        for &x in &values {
+            for (&lo, &hi) in values.iter().zip(values.iter().rev()).take(200) {
+                let (lo, hi) = if lo <= hi { (lo, hi) } else { (hi, lo) };
+                assert_eq!(clamp(x, lo, hi).to_bits(), x.clamp(lo, hi).to_bits(), "{x} in [{lo}, {hi}]");
+            }
+        }
+        assert!(clamp(f32::NAN, -1.0, 1.0).is_nan());
+        // Bounds the wrong way round give `hi`, not a panic.
+        assert_eq!(clamp(0.0, 1.0, -1.0), -1.0);
+    }
+}
