@@ -53,7 +53,17 @@ mod tests {
 
     #[test]
     fn clamp_has_f32_clamps_bits_and_never_panics() {
-        let specials = [0.0f32, -0.0, 1.0, -1.0, 2.8973, -2.8973, 1e-30, f32::INFINITY, f32::NEG_INFINITY];
+        let specials = [
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.0,
+            2.8973,
+            -2.8973,
+            1e-30,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
         let mut rng = crate::rng::Rng::new(7);
         let values = specials
             .into_iter()
@@ -62,7 +72,11 @@ mod tests {
         for &x in &values {
             for (&lo, &hi) in values.iter().zip(values.iter().rev()).take(200) {
                 let (lo, hi) = if lo <= hi { (lo, hi) } else { (hi, lo) };
-                assert_eq!(clamp(x, lo, hi).to_bits(), x.clamp(lo, hi).to_bits(), "{x} in [{lo}, {hi}]");
+                assert_eq!(
+                    clamp(x, lo, hi).to_bits(),
+                    x.clamp(lo, hi).to_bits(),
+                    "{x} in [{lo}, {hi}]"
+                );
             }
         }
         assert!(clamp(f32::NAN, -1.0, 1.0).is_nan());

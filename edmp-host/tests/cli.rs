@@ -34,8 +34,9 @@ fn rrt_plans_the_example_and_writes_the_file() {
     assert_eq!(waypoints[0].as_array().unwrap()[0].as_f64().unwrap() as f32, 0.6);
 }
 
-/// `plan` and `rrt` read the arm from the scene: an xArm 6 problem is planned with 6 joints and
-/// a 7-joint start is refused by its path; a Panda-only command names the arm it refuses.
+/// `plan`, `rrt` and `render` read the arm from the scene: an xArm 6 problem is planned with 6
+/// joints and drawn with its plan, a 7-joint start is refused by its path; a Panda-only command
+/// names the arm it refuses.
 #[test]
 fn another_arms_scene_is_planned_with_its_joints_or_refused_by_name() {
     let scene = "benchmarks/xarm6/problems/cubby/000.json";
@@ -72,6 +73,31 @@ fn another_arms_scene_is_planned_with_its_joints_or_refused_by_name() {
     }
     let dir = std::env::temp_dir().join(format!("edmp-xarm6-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    let (plan, png) = (dir.join("plan.json"), dir.join("plan.png"));
+    assert!(
+        edmp_host(&["plan", scene, "-o", plan.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let out = edmp_host(&["render", scene, plan.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+    assert!(out.status.success(), "render: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    // A Panda's plan (7 joints) drawn over the xArm's scene is refused by its path.
+    let panda_plan = dir.join("panda.json");
+    assert!(
+        edmp_host(&["plan", "examples/wall.json", "-o", panda_plan.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let out = edmp_host(&[
+        "render",
+        scene,
+        panda_plan.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("waypoints[0]: expected 6 numbers, found 7"));
     let seven = dir.join("seven.json");
     let mut bad = doc.clone();
     bad["start"].as_array_mut().unwrap().push(serde_json::json!(0.0));

@@ -10,12 +10,13 @@
 //! translucent as a primitive.
 //! A small convex-polygon rasteriser and the `png` encoder; no system fonts or libraries.
 
-use crate::formats::json::{Goal, Problem, parse_problem_in};
-use crate::formats::plan::{PlanDocument, parse_plan};
+use crate::formats::json::{Goal, Problem, parse_problem_for, scene_arm};
+use crate::formats::plan::{PlanDocument, parse_plan_for};
 use crate::formats::surface::SurfaceKind;
+use crate::with_arm;
 use edmp_core::collision::convex::{Convex, Solid};
 use edmp_core::robot::kinematics::{Joints, forward, forward_with};
-use edmp_core::robot::{BODIES, PANDA};
+use edmp_core::robot::{MAX_FRAMES, Robot};
 use edmp_core::scene::Shape;
 use nalgebra::Vector3;
 use std::path::PathBuf;
@@ -395,7 +396,7 @@ fn thinned(points: &[[f32; 3]], max: usize) -> impl Iterator<Item = &[f32; 3]> {
 }
 
 /// The scene's clouds and meshes, in every view.
-fn draw_surfaces(canvas: &mut Canvas, problem: &Problem) {
+fn draw_surfaces<const J: usize>(canvas: &mut Canvas, problem: &Problem<J>) {
     for o in &problem.surfaces.obstacles {
         for view in VIEWS {
             let mut layer = Layer::new(view);
@@ -427,9 +428,10 @@ fn draw(canvas: &mut Canvas, points: &[Vector3<f32>], color: [f32; 3], alpha: f3
 }
 
 /// The TCP's path along a trajectory, as a polyline in every view.
-fn draw_tcp_path(
+fn draw_tcp_path<const J: usize>(
     canvas: &mut Canvas,
-    path: &[Joints<f32>],
+    robot: &'static Robot<f32, J>,
+    path: &[Joints<f32, J>],
     width: f32,
     color: [f32; 3],
     alpha: f32,
@@ -437,7 +439,7 @@ fn draw_tcp_path(
     let points: Vec<Vector3<f32>> = path
         .iter()
         .map(|q| {
-            forward(&PANDA, q)
+            forward(robot, q)
                 .map(|k| k.tcp().translation)
                 .map_err(|e| e.to_string())
         })
@@ -450,25 +452,38 @@ fn draw_tcp_path(
     Ok(())
 }
 
-fn draw_robot(canvas: &mut Canvas, q: &Joints<f32>, finger: f32, color: [f32; 3], alpha: f32) -> Result<(), String> {
-    let k = forward_with(&PANDA, q, finger).map_err(|e| e.to_string())?;
-    for b in 0..BODIES {
-        let pose = &k.frames[PANDA.bodies[b].frame];
-        let pts: Vec<_> = PANDA.hull(b).iter().map(|p| pose.transform_point(p)).collect();
+/// The arm's collision hulls at `q` (the fingers at `finger` where it has them).
+fn draw_robot<const J: usize>(
+    canvas: &mut Canvas,
+    robot: &'static Robot<f32, J>,
+    q: &Joints<f32, J>,
+    finger: f32,
+    color: [f32; 3],
+    alpha: f32,
+) -> Result<(), String> {
+    let k = forward_with(robot, q, robot.finger_opening(finger)).map_err(|e| e.to_string())?;
+    for (b, body) in robot.bodies.iter().enumerate() {
+        let pose = &k.frames[body.frame.min(MAX_FRAMES - 1)];
+        let pts: Vec<_> = robot.hull(b).iter().map(|p| pose.transform_point(p)).collect();
         draw(canvas, &pts, color, alpha);
     }
     Ok(())
 }
 
-/// Reads the scene (and plan), draws them and writes the PNG.
+/// Reads the scene (and plan), draws them with the arm the scene names and writes the PNG.
 pub fn run(args: &Args) -> Result<(), String> {
     let text = std::fs::read_to_string(&args.scene).map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    let arm = scene_arm(&text).map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    with_arm!(arm, robot => render(args, &text, robot))
+}
+
+fn render<const J: usize>(args: &Args, text: &str, robot: &'static Robot<f32, J>) -> Result<(), String> {
     let dir = args.scene.parent().unwrap_or(std::path::Path::new("."));
-    let problem = parse_problem_in(&text, dir).map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    let problem = parse_problem_for(text, dir, robot).map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let plan = match &args.plan {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            Some(parse_plan(&text).map_err(|e| format!("{}: {e}", path.display()))?)
+            Some(parse_plan_for::<J>(&text).map_err(|e| format!("{}: {e}", path.display()))?)
         }
         None => None,
     };
@@ -476,7 +491,12 @@ pub fn run(args: &Args) -> Result<(), String> {
 }
 
 /// The three views of `problem` (and `plan`, its candidates' paths with `candidates`).
-fn picture(problem: &Problem, plan: Option<&PlanDocument>, candidates: bool) -> Result<Canvas, String> {
+fn picture<const J: usize>(
+    problem: &Problem<J>,
+    plan: Option<&PlanDocument<J>>,
+    candidates: bool,
+) -> Result<Canvas, String> {
+    let robot = problem.robot;
     let mut canvas = Canvas::new(VIEWS.len() * PANEL, PANEL);
     // Panel frames and the floor line of the side and front views.
     for panel in 1..VIEWS.len() {
@@ -514,6 +534,7 @@ fn picture(problem: &Problem, plan: Option<&PlanDocument>, candidates: bool) -> 
         for (i, q) in path.iter().enumerate().step_by(4) {
             draw_robot(
                 &mut canvas,
+                robot,
                 q,
                 finger,
                 [0.95, 0.55, 0.1],
@@ -521,9 +542,9 @@ fn picture(problem: &Problem, plan: Option<&PlanDocument>, candidates: bool) -> 
             )?;
         }
     }
-    draw_robot(&mut canvas, &problem.start, finger, [0.15, 0.35, 0.85], 0.35)?;
+    draw_robot(&mut canvas, robot, &problem.start, finger, [0.15, 0.35, 0.85], 0.35)?;
     if let Goal::Joints(goal) = problem.goal {
-        draw_robot(&mut canvas, &goal, finger, [0.1, 0.65, 0.25], 0.35)?;
+        draw_robot(&mut canvas, robot, &goal, finger, [0.1, 0.65, 0.25], 0.35)?;
     }
     if candidates {
         let list = plan
@@ -538,11 +559,11 @@ fn picture(problem: &Problem, plan: Option<&PlanDocument>, candidates: bool) -> 
             } else {
                 [0.55; 3]
             };
-            draw_tcp_path(&mut canvas, &c.waypoints, 2.0, colour, 0.8)?;
+            draw_tcp_path(&mut canvas, robot, &c.waypoints, 2.0, colour, 0.8)?;
         }
     }
     if let Some(path) = &path {
-        draw_tcp_path(&mut canvas, path, 3.5, [0.6, 0.05, 0.05], 0.95)?;
+        draw_tcp_path(&mut canvas, robot, path, 3.5, [0.6, 0.05, 0.05], 0.95)?;
     }
     Ok(canvas)
 }

@@ -292,7 +292,7 @@ pub fn parse_problem_for<const J: usize>(
         return Err(InputError::at(
             "robot",
             format!(
-                "\"{arm}\": this command runs the {} only (`edmp-host plan`, `rrt` and `fk --robot` take every arm)",
+                "\"{arm}\": this command runs the {} only (`edmp-host plan`, `rrt`, `render` and `fk --robot` take every arm)",
                 robot.name
             ),
         ));

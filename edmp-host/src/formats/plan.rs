@@ -122,36 +122,36 @@ pub fn add_trajectory<const J: usize>(
     Ok(true)
 }
 
-/// One alternative path of a plan written with `--candidates`.
+/// One alternative path of a plan written with `--candidates`, for an arm of `J` joints.
 #[derive(Clone, Debug, PartialEq)]
-pub struct PlanCandidate {
+pub struct PlanCandidate<const J: usize = JOINTS> {
     /// The guide that steered it.
     pub guide: Option<u64>,
     /// Whether the checker passed it.
     pub collision_free: bool,
     /// Its waypoints.
-    pub waypoints: Vec<Joints<f32>>,
+    pub waypoints: Vec<Joints<f32, J>>,
 }
 
 /// An `edmp-plan/1` document as read back (by `edmp-host view`): the chosen path, its timed
 /// trajectory, the candidates and the report fields. Fields it does not use are not checked.
 #[derive(Clone, Debug, PartialEq)]
-pub struct PlanDocument {
+pub struct PlanDocument<const J: usize = JOINTS> {
     /// `"success"` or `"collision"`.
     pub status: String,
     /// The stage that found the path (`diffusion`, `reseeded`, `search`), when written.
     pub stage: Option<String>,
     /// The chosen path.
-    pub waypoints: Vec<Joints<f32>>,
+    pub waypoints: Vec<Joints<f32, J>>,
     /// `trajectory.points` as (time from start in seconds, joint positions), when timed.
-    pub trajectory: Vec<(f32, Joints<f32>)>,
+    pub trajectory: Vec<(f32, Joints<f32, J>)>,
     /// `candidates`, empty when the plan was written without them.
-    pub candidates: Vec<PlanCandidate>,
+    pub candidates: Vec<PlanCandidate<J>>,
     /// `timing_ms`: every stage's milliseconds, by name.
     pub timing_ms: Vec<(String, f64)>,
 }
 
-fn path_of(v: &Value, path: &str) -> Result<Vec<Joints<f32>>, InputError> {
+fn path_of<const J: usize>(v: &Value, path: &str) -> Result<Vec<Joints<f32, J>>, InputError> {
     let rows = v
         .as_array()
         .ok_or_else(|| InputError::at(path, "expected an array of waypoints"))?;
@@ -160,12 +160,17 @@ fn path_of(v: &Value, path: &str) -> Result<Vec<Joints<f32>>, InputError> {
     }
     rows.iter()
         .enumerate()
-        .map(|(i, row)| numbers::<JOINTS>(row, &format!("{path}[{i}]")))
+        .map(|(i, row)| numbers::<J>(row, &format!("{path}[{i}]")))
         .collect()
 }
 
-/// Parses an `edmp-plan/1` document (what `edmp-host plan` writes) for reading back.
+/// Parses a Panda's `edmp-plan/1` document (what `edmp-host plan` writes) for reading back.
 pub fn parse_plan(text: &str) -> Result<PlanDocument, InputError> {
+    parse_plan_for::<JOINTS>(text)
+}
+
+/// [`parse_plan`] for an arm of `J` joints: every joint vector must have `J` entries.
+pub fn parse_plan_for<const J: usize>(text: &str) -> Result<PlanDocument<J>, InputError> {
     let root: Value = serde_json::from_str(text).map_err(|e| InputError::at("", format!("not valid JSON: {e}")))?;
     let map = root
         .as_object()
@@ -208,7 +213,7 @@ pub fn parse_plan(text: &str) -> Result<PlanDocument, InputError> {
                     format!("{time} is before the previous point's time"),
                 ));
             }
-            trajectory.push((time, numbers::<JOINTS>(q, &qp)?));
+            trajectory.push((time, numbers::<J>(q, &qp)?));
         }
     }
     let mut candidates = Vec::new();
