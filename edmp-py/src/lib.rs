@@ -9,7 +9,7 @@ use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::path::HORIZON;
 use edmp_core::planner::{Judging, PlanConfig};
 use edmp_core::prior::Network;
-use edmp_core::robot::{JOINT_NAMES, JOINTS, Robot};
+use edmp_core::robot::Robot;
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;
 use edmp_host::formats::json::{Goal, Problem, describe, joint_goal, parse_problem, parse_problem_for, scene_arm};
@@ -174,19 +174,20 @@ fn plan_problem_ms(py: Python<'_>, scene: &str, seed: u64, repeats: u32) -> PyRe
     .map_err(failure)
 }
 
-fn joints_of(q: &[f64], what: &str) -> PyResult<[f32; JOINTS]> {
-    if q.len() != JOINTS {
+/// `q` as `robot`'s joints: `J` finite numbers, else a `ValueError` naming the entry.
+fn joints_of<const J: usize>(robot: &Robot<f32, J>, q: &[f64], what: &str) -> PyResult<[f32; J]> {
+    if q.len() != J {
         return Err(PyValueError::new_err(format!(
-            "{what}: expected {JOINTS} joint angles, found {}",
+            "{what}: expected {J} joint angles, found {}",
             q.len()
         )));
     }
-    let mut out = [0.0f32; JOINTS];
+    let mut out = [0.0f32; J];
     for (i, (slot, &x)) in out.iter_mut().zip(q).enumerate() {
         if !x.is_finite() || x.abs() > f64::from(f32::MAX) {
             return Err(PyValueError::new_err(format!(
                 "{what}[{i}] ({}): {x} is not a finite number",
-                JOINT_NAMES[i]
+                robot.joint_names[i]
             )));
         }
         *slot = x as f32;
@@ -198,34 +199,33 @@ fn joints_of(q: &[f64], what: &str) -> PyResult<[f32; JOINTS]> {
 /// frame and every collision box.
 #[pyfunction]
 fn fk(q: Vec<f64>) -> PyResult<String> {
-    let q = joints_of(&q, "q")?;
+    let q = joints_of(&edmp_core::robot::PANDA, &q, "q")?;
     let doc = edmp_host::commands::fk::document(&q).map_err(|e| PyValueError::new_err(format!("q: {e}")))?;
     to_json(&doc)
 }
 
 /// The exact checker (`checker::check_trajectory`, every contact counted) on `HORIZON`
-/// waypoints in the scene: a JSON report.
+/// waypoints of the scene's arm in the scene: a JSON report.
 #[pyfunction]
 fn check(scene: &str, waypoints: Vec<Vec<f64>>) -> PyResult<String> {
-    let problem = parse(scene)?;
+    let arm = scene_arm(scene).map_err(scene_error)?;
+    with_arm!(arm, robot => check_for(scene, robot, &waypoints))
+}
+
+fn check_for<const J: usize>(scene: &str, robot: &'static Robot<f32, J>, waypoints: &[Vec<f64>]) -> PyResult<String> {
+    let problem = parse_for(scene, robot)?;
     if waypoints.len() != HORIZON {
         return Err(PyValueError::new_err(format!(
             "waypoints: expected {HORIZON} rows (the plan format's), found {}",
             waypoints.len()
         )));
     }
-    let mut path = [[0.0f32; JOINTS]; HORIZON];
-    for (i, (slot, row)) in path.iter_mut().zip(&waypoints).enumerate() {
-        *slot = joints_of(row, &format!("waypoints[{i}]"))?;
+    let mut path = [[0.0f32; J]; HORIZON];
+    for (i, (slot, row)) in path.iter_mut().zip(waypoints).enumerate() {
+        *slot = joints_of(robot, row, &format!("waypoints[{i}]"))?;
     }
-    let report = check_trajectory(
-        &edmp_core::robot::PANDA,
-        &problem.scene(),
-        &path,
-        &CheckConfig::default(),
-        false,
-    )
-    .map_err(|e| PlanError::new_err(format!("checker: {e}")))?;
+    let report = check_trajectory(robot, &problem.scene(), &path, &CheckConfig::default(), false)
+        .map_err(|e| PlanError::new_err(format!("checker: {e}")))?;
     let first = report.first_contact.map(
         |c| json!({"segment": c.segment, "step": c.step, "contact": describe(problem.robot, c.contact, &problem.primitive_index)}),
     );
@@ -237,18 +237,28 @@ fn check(scene: &str, waypoints: Vec<Vec<f64>>) -> PyResult<String> {
     }))
 }
 
-/// The core IK as a pose goal uses it (`json::joint_goal`): the collision-free solution in the
-/// scene nearest its start, or `None` when none is found.
+/// The core IK of the scene's arm as a pose goal uses it (`json::joint_goal`): the
+/// collision-free solution in the scene nearest its start, or `None` when none is found.
 #[pyfunction]
 fn ik(scene: &str, position: Vec<f64>, quaternion: Vec<f64>) -> PyResult<Option<Vec<f32>>> {
-    let problem = parse(scene)?;
+    let arm = scene_arm(scene).map_err(scene_error)?;
+    with_arm!(arm, robot => ik_for(scene, robot, &position, &quaternion))
+}
+
+fn ik_for<const J: usize>(
+    scene: &str,
+    robot: &'static Robot<f32, J>,
+    position: &[f64],
+    quaternion: &[f64],
+) -> PyResult<Option<Vec<f32>>> {
+    let problem = parse_for(scene, robot)?;
     let finite = |v: &[f64], n: usize, what: &str| -> PyResult<Vec<f32>> {
         if v.len() != n || v.iter().any(|x| !x.is_finite()) {
             return Err(PyValueError::new_err(format!("{what}: expected {n} finite numbers")));
         }
         Ok(v.iter().map(|&x| x as f32).collect())
     };
-    let (p, q) = (finite(&position, 3, "position")?, finite(&quaternion, 4, "quaternion")?);
+    let (p, q) = (finite(position, 3, "position")?, finite(quaternion, 4, "quaternion")?);
     let norm = q.iter().map(|x| x * x).sum::<f32>().sqrt();
     if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
         return Err(PyValueError::new_err(format!("quaternion: norm {norm:.2}, expected 1")));

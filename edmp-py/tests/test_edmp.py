@@ -528,5 +528,12 @@ def test_another_arms_scene_plans_with_its_joints_and_is_the_cli_document(robot:
     bad["start"] = bad["start"] + [0.0]
     with pytest.raises(edmp.SceneError, match=f"start: expected {joints} numbers, found {joints + 1}"):
         edmp.Scene.from_dict(bad)
-    with pytest.raises(edmp.SceneError, match=f'robot: "{robot}": this command runs the panda only'):
-        edmp.ik(scene, [0.4, 0.0, 0.4], [0.0, 1.0, 0.0, 0.0])
+    report = edmp.check(scene, p.waypoints)
+    assert report and report.colliding_states == 0
+    straight = np.linspace(scene.start, scene.goal, 50)
+    assert edmp.check(scene, straight).states >= 50
+    with pytest.raises(ValueError, match=rf"waypoints\[0\]: expected {joints} joint angles, found {joints + 1}"):
+        edmp.check(scene, np.hstack([p.waypoints, np.zeros((50, 1))]))
+    pose = scene.to_dict()["meta"]["goal_pose"]
+    q = edmp.ik(scene, pose["position"], pose["quaternion"])
+    assert q is not None and q.shape == (joints,)

@@ -13,7 +13,8 @@ CLI's ``edmp-plan/1`` document, parsed.
 
 A scene names its arm in ``robot`` (``"panda"`` when absent, ``"iiwa7"``, ``"xarm6"``); joint
 vectors then have that arm's joint count (:attr:`Scene.robot`). :func:`plan` plans for every
-arm; :func:`fk`, :func:`check`, :func:`ik`, :func:`import_moveit` and the viewer run the Panda.
+arm, and so do :func:`check` and :func:`ik`; :func:`fk`, :func:`import_moveit` and the viewer
+run the Panda.
 """
 
 from __future__ import annotations
@@ -476,11 +477,12 @@ class CheckReport:
 
 
 def check(scene: Union[Scene, Mapping[str, Any]], waypoints: ArrayLike) -> CheckReport:
-    """Checks a ``(50, 7)`` trajectory in the scene with the core's exact checker
-    (``checker::check_trajectory``, the rule of a solved problem; every contact counted)."""
+    """Checks a ``(50, J)`` trajectory of the scene's arm (``J`` its joints, 7 for the Panda) in
+    the scene with the core's exact checker (``checker::check_trajectory``, the rule of a solved
+    problem; every contact counted)."""
     w = np.asarray(waypoints, dtype=np.float64)
-    if w.ndim != 2 or w.shape[1] != 7:
-        raise ValueError(f"waypoints: expected shape (50, 7), found {w.shape}")
+    if w.ndim != 2:
+        raise ValueError(f"waypoints: expected shape (50, J), found {w.shape}")
     r = json.loads(_edmp.check(_scene_text(scene), w.tolist()))
     return CheckReport(r["free"], r["states"], r["colliding_states"], r["first_contact"])
 
@@ -490,9 +492,9 @@ def ik(
     position: ArrayLike,
     quaternion: ArrayLike,
 ) -> Optional[Array]:
-    """Joints that put the TCP at ``position`` / ``quaternion`` (``[w, x, y, z]``), within the
-    limits and collision-free in the scene, nearest its start: the core IK as a pose goal
-    uses it. ``None`` when no solution is found."""
+    """Joints of the scene's arm that put the TCP at ``position`` / ``quaternion``
+    (``[w, x, y, z]``), within the limits and collision-free in the scene, nearest its start: the
+    core IK as a pose goal uses it. ``None`` when no solution is found."""
     q = _edmp.ik(
         _scene_text(scene),
         _vector(position, 3, "position"),
