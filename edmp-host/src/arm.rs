@@ -54,29 +54,29 @@ impl fmt::Display for Arm {
 /// `with_arm!(arm, robot => expr)`: evaluates `expr` with `robot` bound to the arm's `f32`
 /// tables (`&'static Robot<f32, J>`, each arm its own `J`), so generic code runs for the
 /// arm named at run time. `with_arm!(arm, robot, network => expr)` also binds `network` to
-/// the arm's trained prior (`&'static Network<J>`), or returns an error naming the arm from
-/// the enclosing `Result<_, String>` function when it has none yet.
+/// the arm's trained prior (`&'static Network<J>`) and is `Ok(expr)`, or an `Err` naming the
+/// arm when it has no trained prior yet.
 #[macro_export]
 macro_rules! with_arm {
     ($arm:expr, $robot:ident, $network:ident => $body:expr) => {
         match $arm {
             $crate::arm::Arm::Panda => {
                 let ($robot, $network) = (&edmp_core::robot::arms::panda::ROBOT, edmp_core::prior::PANDA);
-                $body
+                Ok($body)
             }
             $crate::arm::Arm::Iiwa7 => {
                 let $robot = &edmp_core::robot::arms::iiwa7::ROBOT;
-                let Some($network) = edmp_core::prior::arms::iiwa7::NETWORK else {
-                    return Err($crate::arm::untrained($crate::arm::Arm::Iiwa7));
-                };
-                $body
+                match edmp_core::prior::arms::iiwa7::NETWORK {
+                    Some($network) => Ok($body),
+                    None => Err($crate::arm::untrained($crate::arm::Arm::Iiwa7)),
+                }
             }
             $crate::arm::Arm::Xarm6 => {
                 let $robot = &edmp_core::robot::arms::xarm6::ROBOT;
-                let Some($network) = edmp_core::prior::arms::xarm6::NETWORK else {
-                    return Err($crate::arm::untrained($crate::arm::Arm::Xarm6));
-                };
-                $body
+                match edmp_core::prior::arms::xarm6::NETWORK {
+                    Some($network) => Ok($body),
+                    None => Err($crate::arm::untrained($crate::arm::Arm::Xarm6)),
+                }
             }
         }
     };

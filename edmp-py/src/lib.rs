@@ -107,11 +107,7 @@ fn plan(
         candidates,
         request,
     };
-    // `with_arm!` returns the error of an arm without a trained prior from this closure.
-    let on_arm = || -> Result<PyResult<String>, String> {
-        Ok(with_arm!(arm, robot, network => plan_for(py, scene, robot, network, &options)))
-    };
-    on_arm().map_err(PlanError::new_err)?
+    with_arm!(arm, robot, network => plan_for(py, scene, robot, network, &options)).map_err(PlanError::new_err)?
 }
 
 /// What `plan` asks beyond the scene.

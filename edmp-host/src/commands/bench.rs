@@ -179,11 +179,7 @@ struct Job<'a> {
 }
 
 fn run_edmp(args: &Args, job: &Job<'_>) -> Result<Record, Failure> {
-    // `with_arm!` returns the error of an arm without a trained prior from this closure.
-    let on_arm = || -> Result<Result<Record, Failure>, String> {
-        Ok(with_arm!(args.robot, robot, network => run_edmp_for(robot, network, args, job)))
-    };
-    on_arm().map_err(Failure::Input)?
+    with_arm!(args.robot, robot, network => run_edmp_for(robot, network, args, job)).map_err(Failure::Input)?
 }
 
 fn run_edmp_for<const J: usize>(

@@ -385,11 +385,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         std::fs::read_to_string(&args.scene).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let in_file = |e: String| Failure::Input(format!("{}: {e}", args.scene.display()));
     let arm = scene_arm(&text).map_err(|e| in_file(e.to_string()))?;
-    // `with_arm!` returns the error of an arm without a trained prior from this closure.
-    let planned = || -> Result<Result<(), Failure>, String> {
-        Ok(with_arm!(arm, robot, network => plan_for(args, began, &text, robot, network)))
-    };
-    planned().map_err(in_file)?
+    with_arm!(arm, robot, network => plan_for(args, began, &text, robot, network)).map_err(in_file)?
 }
 
 fn plan_for<const J: usize>(

@@ -177,7 +177,7 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 
 /// Runs the measurement and prints the table.
 pub fn run(args: &Args) -> Result<(), String> {
-    with_arm!(args.robot, robot, network => measure(robot, network, args))
+    with_arm!(args.robot, robot, network => measure(robot, network, args))?
 }
 
 fn measure<const J: usize>(robot: &'static Robot<f32, J>, network: &Network<J>, args: &Args) -> Result<(), String> {
