@@ -74,8 +74,8 @@ fn assert_same_primitive(a: &Value, b: &Value, tol: f64, what: &str) {
 
 #[test]
 fn the_table_scene_with_a_joint_goal_is_the_wall_example() {
-    let (doc, problem) =
-        import_validated(&file("table_box.scene.yaml"), Some(&file("joint_goal.request.yaml"))).unwrap();
+    let doc = import_validated(&file("table_box.scene.yaml"), Some(&file("joint_goal.request.yaml"))).unwrap();
+    let problem = parse_problem(&doc.to_string()).unwrap();
     let wall = example("wall.json");
     let (got, want) = (
         doc["obstacles"].as_array().unwrap(),
@@ -116,8 +116,8 @@ fn the_table_scene_with_a_joint_goal_is_the_wall_example() {
 
 #[test]
 fn a_hand_pose_goal_becomes_the_tcp_pose() {
-    let (doc, problem) =
-        import_validated(&file("table_box.scene.yaml"), Some(&file("pose_goal.request.yaml"))).unwrap();
+    let doc = import_validated(&file("table_box.scene.yaml"), Some(&file("pose_goal.request.yaml"))).unwrap();
+    let problem = parse_problem(&doc.to_string()).unwrap();
     let pose = &doc["goal"]["pose"];
     // FK of the wall example's goal: the hand points straight down, so the TCP is 0.105 m lower.
     assert!(
@@ -252,7 +252,7 @@ fn unsupported_or_bad_entries_name_their_yaml_path() {
         (
             scene.clone(),
             Some(joint_request.replace("group_name: panda_arm", "group_name: hand")),
-            "request: group_name: \"hand\": only panda_arm or panda_manipulator",
+            "request: group_name: \"hand\": panda's groups are panda_arm, panda_manipulator",
         ),
         (
             scene.clone(),
@@ -288,8 +288,8 @@ fn scenes_as_moveit_and_motionbenchmaker_export_them_are_the_explicit_frame_scen
             Some(file("joint_goal.request.yaml")),
             Some(file("pose_goal.request.yaml")),
         ] {
-            let (got, _) = import_validated(&scene, request.as_deref()).unwrap_or_else(|e| panic!("{name}: {e}"));
-            let (want, _) = import_validated(&explicit, request.as_deref()).unwrap();
+            let got = import_validated(&scene, request.as_deref()).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let want = import_validated(&explicit, request.as_deref()).unwrap();
             assert_same_problem(&got, &want, name);
             assert_eq!(
                 got["meta"]["object_ids"],
@@ -299,8 +299,8 @@ fn scenes_as_moveit_and_motionbenchmaker_export_them_are_the_explicit_frame_scen
         }
     }
     // A request as MotionBenchMaker stores it: the pose goal request's problem.
-    let (got, _) = import_validated(&file("robowflex.scene.yaml"), Some(&file("robowflex.request.yaml"))).unwrap();
-    let (want, _) = import_validated(&explicit, Some(&file("pose_goal.request.yaml"))).unwrap();
+    let got = import_validated(&file("robowflex.scene.yaml"), Some(&file("robowflex.request.yaml"))).unwrap();
+    let want = import_validated(&explicit, Some(&file("pose_goal.request.yaml"))).unwrap();
     assert_same_problem(&got, &want, "robowflex.request.yaml");
 }
 
@@ -319,8 +319,8 @@ fn an_object_may_name_a_frame_of_fixed_frame_transforms() {
             "    - id: table\n      header: {frame_id: table_frame}\n",
         );
     assert!(scene.contains("table_frame}"), "{scene}");
-    let (got, _) = import_validated(&scene, None).unwrap();
-    let (want, _) = import_validated(&file("table_box.scene.yaml"), None).unwrap();
+    let got = import_validated(&scene, None).unwrap();
+    let want = import_validated(&file("table_box.scene.yaml"), None).unwrap();
     let (a, b) = (
         got["obstacles"].as_array().unwrap(),
         want["obstacles"].as_array().unwrap(),
@@ -390,7 +390,7 @@ fn a_placed_virtual_joint_puts_the_world_in_the_base_frame() {
             request.replace("start_state:\n", &format!("start_state:\n{joint}")),
         );
         for (scene, request) in [in_scene, in_request] {
-            let (back, _) =
+            let back =
                 import_validated(&scene, Some(&request)).unwrap_or_else(|e| panic!("{name}: {e}\n{scene}\n{request}"));
             let (a, b) = (
                 original["obstacles"].as_array().unwrap(),
@@ -510,7 +510,7 @@ fn exported_scenes_refuse_what_they_cannot_express_by_yaml_path() {
         )
     };
     // An empty frame is the link's, as MoveIt reads it; no header is ambiguous.
-    let (doc, _) = import_validated(&held("header: {frame_id: ''}\n      "), None).unwrap();
+    let doc = import_validated(&held("header: {frame_id: ''}\n      "), None).unwrap();
     assert_eq!(doc["held_object"]["center"], json!([0.0, 0.0, 0.1]));
     cases.push((
         held(""),
@@ -527,16 +527,17 @@ fn exported_scenes_refuse_what_they_cannot_express_by_yaml_path() {
 #[test]
 fn open_fingers_become_the_gripper_field() {
     let scene = file("table_box.scene.yaml").replace("    - 0.025\n    - 0.025\n", "    - 0.035\n    - 0.035\n");
-    let (doc, problem) = import_validated(&scene, Some(&file("pose_goal.request.yaml"))).unwrap();
+    let doc = import_validated(&scene, Some(&file("pose_goal.request.yaml"))).unwrap();
+    let problem = parse_problem(&doc.to_string()).unwrap();
     assert_eq!(doc["gripper"], json!({"finger": 0.035}));
     assert_eq!(problem.scene().gripper(), 0.035);
-    let (doc, _) = import_validated(&file("table_box.scene.yaml"), None).unwrap();
+    let doc = import_validated(&file("table_box.scene.yaml"), None).unwrap();
     assert!(doc.get("gripper").is_none(), "0.025 m is the format's default");
 }
 
 #[test]
 fn without_a_request_the_start_comes_from_the_scene_and_the_goal_is_the_start() {
-    let (doc, _) = import_validated(&file("table_box.scene.yaml"), None).unwrap();
+    let doc = import_validated(&file("table_box.scene.yaml"), None).unwrap();
     assert_eq!(doc["goal"]["joints"], doc["start"]);
     assert_eq!(doc["meta"]["goal_from"], "start (no request)");
 }
@@ -691,8 +692,9 @@ fn every_example_round_trips_through_moveit_yaml_and_plans_the_same() {
     for name in ["wall.json", "cubby.json", "dresser.json", "tabletop-pose-held.json"] {
         let original = example(name);
         let (scene, request) = to_moveit(&original);
-        let (back, problem) =
+        let back =
             import_validated(&scene, Some(&request)).unwrap_or_else(|e| panic!("{name}: {e}\n{scene}\n{request}"));
+        let problem = parse_problem(&back.to_string()).unwrap();
         let (a, b) = (
             original["obstacles"].as_array().unwrap(),
             back["obstacles"].as_array().unwrap(),
@@ -740,4 +742,127 @@ fn every_example_round_trips_through_moveit_yaml_and_plans_the_same() {
         .unwrap();
         assert_eq!(report.is_free(), got.plan.is_free(), "{name}");
     }
+}
+
+/// A MoveIt scene and joint-goal request for another arm (its joint names, its groups; the
+/// model name optional), with a post behind the arm and a box held by its TCP link.
+fn other_arm_files<const J: usize>(
+    robot: &edmp_core::robot::Robot<f32, J>,
+    model: Option<&str>,
+    group: &str,
+    goal: &[f32; J],
+) -> (String, String) {
+    let list = |q: &[f32]| q.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(", ");
+    let names = robot.joint_names.join(", ");
+    let tcp = robot.frame_names[robot.tcp_frame];
+    let model = model.map_or(String::new(), |m| format!("robot_model_name: {m}\n"));
+    let scene = format!(
+        "{model}robot_state:
+  joint_state:
+    name: [{names}]
+    position: [{start}]
+  multi_dof_joint_state:
+    header: {{frame_id: world}}
+    joint_names: [virtual_joint]
+    transforms: [{{translation: {{x: 0, y: 0, z: 0}}, rotation: {{x: 0, y: 0, z: 0, w: 1}}}}]
+  attached_collision_objects:
+  - link_name: {tcp}
+    object:
+      id: tool
+      header: {{frame_id: {tcp}}}
+      primitives: [{{type: box, dimensions: [0.02, 0.02, 0.02]}}]
+      primitive_poses: [{{position: {{x: 0, y: 0, z: 0.05}}}}]
+world:
+  collision_objects:
+  - id: post
+    header: {{frame_id: world}}
+    primitives: [{{type: box, dimensions: [0.1, 0.1, 0.4]}}]
+    primitive_poses: [{{position: {{x: -0.8, y: 0.0, z: 0.2}}}}]
+",
+        start = list(&robot.neutral)
+    );
+    let constraints: String = robot
+        .joint_names
+        .iter()
+        .zip(goal)
+        .map(|(n, x)| format!("  - {{joint_name: {n}, position: {x}}}\n"))
+        .collect();
+    let request = format!("group_name: {group}\ngoal_constraints:\n- joint_constraints:\n{constraints}");
+    (scene, request)
+}
+
+fn other_arm_is_read_by_its_names<const J: usize>(robot: &'static edmp_core::robot::Robot<f32, J>, group: &str) {
+    let mut goal = robot.neutral;
+    goal[0] += 0.5;
+    for model in [None, Some(robot.name)] {
+        let (scene, request) = other_arm_files(robot, model, group, &goal);
+        let doc = import_validated(&scene, Some(&request)).unwrap_or_else(|e| panic!("{}: {e}\n{scene}", robot.name));
+        assert_eq!(doc["robot"], json!(robot.name));
+        let start: Vec<f64> = robot.neutral.iter().map(|&x| f64::from(x)).collect();
+        assert!(close(&floats(&doc["start"]), &start, 1e-6));
+        let want: Vec<f64> = goal.iter().map(|&x| f64::from(x)).collect();
+        assert!(close(&floats(&doc["goal"]["joints"]), &want, 1e-6));
+        assert_eq!(doc["held_object"]["type"], "cuboid");
+        assert!(close(&floats(&doc["held_object"]["center"]), &[0.0, 0.0, 0.05], 1e-12));
+        let problem =
+            edmp_host::formats::json::parse_problem_for(&doc.to_string(), std::path::Path::new("."), robot).unwrap();
+        assert_eq!(problem.start, robot.neutral);
+    }
+
+    // A pose goal on the TCP link is the TCP pose itself.
+    let k = forward(robot, &goal).unwrap();
+    let tcp = k.tcp();
+    let [w, x, y, z] = tcp.quaternion_wxyz();
+    let link = robot.frame_names[robot.tcp_frame];
+    let (scene, _) = other_arm_files(robot, None, group, &goal);
+    let pose_request = format!(
+        "group_name: {group}
+goal_constraints:
+- position_constraints:
+  - link_name: {link}
+    constraint_region:
+      primitive_poses: [{{position: {{x: {}, y: {}, z: {}}}}}]
+  orientation_constraints:
+  - link_name: {link}
+    orientation: {{x: {x}, y: {y}, z: {z}, w: {w}}}
+",
+        tcp.translation.x, tcp.translation.y, tcp.translation.z
+    );
+    let doc = import_validated(&scene, Some(&pose_request)).unwrap();
+    let p = &doc["goal"]["pose"];
+    let want = [tcp.translation.x, tcp.translation.y, tcp.translation.z].map(f64::from);
+    assert!(close(&floats(&p["position"]), &want, 1e-6), "{p}");
+    assert!(
+        same_rotation(&floats(&p["quaternion"]), &[w, x, y, z].map(f64::from), 1e-6),
+        "{p}"
+    );
+
+    // What does not fit the arm is refused by path, naming the arm's own names.
+    let (scene, request) = other_arm_files(robot, None, "panda_arm", &goal);
+    let e = import_validated(&scene, Some(&request)).unwrap_err();
+    assert!(e.contains("group_name") && e.contains(group), "{e}");
+    let (scene, request) = other_arm_files(robot, None, group, &goal);
+    let mixed = request.replacen(robot.joint_names[1], "panda_joint2", 1);
+    let e = import_validated(&scene, Some(&mixed)).unwrap_err();
+    assert!(
+        e.contains("unknown joint \"panda_joint2\"") && e.contains(robot.joint_names[1]),
+        "{e}"
+    );
+    let e = import_validated(&format!("robot_model_name: ur5\n{scene}"), Some(&request)).unwrap_err();
+    assert!(e.contains("robot_model_name") && e.contains("ur5"), "{e}");
+    let held_by_base = scene.replace(
+        &format!("link_name: {link}"),
+        &format!("link_name: {}", robot.frame_names[1]),
+    );
+    let e = import_validated(&held_by_base, Some(&request)).unwrap_err();
+    assert!(
+        e.contains("attached_collision_objects[0].link_name") && e.contains(link),
+        "{e}"
+    );
+}
+
+#[test]
+fn another_arms_scene_is_read_by_its_joint_names() {
+    other_arm_is_read_by_its_names(&edmp_core::robot::arms::iiwa7::ROBOT, "manipulator");
+    other_arm_is_read_by_its_names(&edmp_core::robot::arms::xarm6::ROBOT, "xarm6");
 }

@@ -12,6 +12,7 @@ use edmp_core::prior::Network;
 use edmp_core::robot::Robot;
 use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;
+use edmp_host::arm::Arm;
 use edmp_host::formats::json::{Goal, Problem, describe, joint_goal, parse_problem, parse_problem_for, scene_arm};
 use edmp_host::formats::plan::{add_trajectory, parse_plan, plan_document};
 use edmp_host::formats::trajectory::TimedRequest;
@@ -191,13 +192,33 @@ fn joints_of<const J: usize>(robot: &Robot<f32, J>, q: &[f64], what: &str) -> Py
     Ok(out)
 }
 
-/// Forward kinematics as `edmp-host fk --json` prints it (JSON text): the TCP, every link
-/// frame and every collision box.
+/// Forward kinematics of the arm called `robot` (the scene format's names) as `edmp-host fk
+/// --robot ROBOT --json` prints it (JSON text): the TCP, every link frame and every collision
+/// box.
 #[pyfunction]
-fn fk(q: Vec<f64>) -> PyResult<String> {
-    let q = joints_of(&edmp_core::robot::PANDA, &q, "q")?;
-    let doc = edmp_host::commands::fk::document(&q).map_err(|e| PyValueError::new_err(format!("q: {e}")))?;
+#[pyo3(signature = (q, robot = "panda"))]
+fn fk(q: Vec<f64>, robot: &str) -> PyResult<String> {
+    let doc = with_arm!(arm_named(robot)?, robot => joints_of(robot, &q, "q").and_then(|q| {
+        edmp_host::commands::fk::document(robot, &q).map_err(|e| PyValueError::new_err(format!("q: {e}")))
+    }))?;
     to_json(&doc)
+}
+
+/// The arm called `name` (the scene format's `robot`), else a `ValueError` listing the known ones.
+fn arm_named(name: &str) -> PyResult<Arm> {
+    Arm::from_name(name).ok_or_else(|| {
+        let known: Vec<&str> = Arm::ALL.iter().map(|a| a.name()).collect();
+        PyValueError::new_err(format!(
+            "robot: \"{name}\" is not an arm this package knows ({})",
+            known.join(", ")
+        ))
+    })
+}
+
+/// The joint names of the arm called `robot`, joint 1 first.
+#[pyfunction]
+fn joint_names(robot: &str) -> PyResult<Vec<&'static str>> {
+    Ok(with_arm!(arm_named(robot)?, robot => robot.joint_names.to_vec()))
 }
 
 /// The exact checker (`checker::check_trajectory`, every contact counted) on `HORIZON`
@@ -272,7 +293,7 @@ fn ik_for<const J: usize>(
 #[pyfunction]
 #[pyo3(signature = (scene_yaml, request_yaml = None))]
 fn import_moveit(scene_yaml: &str, request_yaml: Option<&str>) -> PyResult<String> {
-    let (doc, _) = edmp_host::formats::moveit::import_validated(scene_yaml, request_yaml).map_err(scene_error)?;
+    let doc = edmp_host::formats::moveit::import_validated(scene_yaml, request_yaml).map_err(scene_error)?;
     to_json(&doc)
 }
 
@@ -315,7 +336,7 @@ fn points_from_depth<'py>(
 mod _edmp {
     #[pymodule_export]
     use super::{
-        PlanError, SceneError, check, fk, ik, import_moveit, plan, plan_problem_ms, points_from_depth, validate,
-        view_page,
+        PlanError, SceneError, check, fk, ik, import_moveit, joint_names, plan, plan_problem_ms, points_from_depth,
+        validate, view_page,
     };
 }

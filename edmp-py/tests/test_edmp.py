@@ -149,6 +149,32 @@ def test_fk_is_what_the_cli_prints() -> None:
             np.testing.assert_array_equal(np.float32(a["quaternion"]), np.float32(b["quaternion"]))
 
 
+@pytest.mark.parametrize("robot, joints, tcp", [("iiwa7", 7, "lbr_iiwa_link_7"), ("xarm6", 6, "link6")])
+def test_fk_of_another_arm(robot: str, joints: int, tcp: str) -> None:
+    names = edmp.joint_names(robot)
+    assert len(names) == joints
+    r = edmp.fk(np.zeros(joints), robot=robot)
+    assert r["robot"] == robot and r["tcp_frame"] == tcp
+    assert r["frames"][0]["position"].shape == (3,)
+    with pytest.raises(ValueError, match=f"expected shape \\({joints},\\)"):
+        edmp.fk(np.zeros(joints + 1), robot=robot)
+    with pytest.raises(ValueError, match="not an arm this package knows"):
+        edmp.fk(np.zeros(7), robot="ur5")
+
+
+@pytest.mark.skipif(HOST is None, reason="EDMP_HOST (the edmp-host binary) not set")
+@pytest.mark.parametrize("robot", ["iiwa7", "xarm6"])
+def test_fk_of_another_arm_is_what_the_cli_prints(robot: str) -> None:
+    q = ["0.3", "-0.4", "0.5", "-1.2", "0.6", "0.9", "-0.2"][: len(edmp.joint_names(robot))]
+    out = subprocess.run([HOST, "fk", *q, "--robot", robot, "--json"], capture_output=True, text=True, check=True)
+    cli = json.loads(out.stdout)
+    ours = edmp.fk([float(x) for x in q], robot=robot)
+    for key in ("frames", "collision_boxes"):
+        for a, b in zip(cli[key], ours[key], strict=True):
+            assert a["name"] == b["name"]
+            np.testing.assert_array_equal(np.float32(a["position"]), np.float32(b["position"]))
+
+
 def test_check_tells_a_free_path_from_a_colliding_one(wall: edmp.Scene, wall_plan: edmp.Plan) -> None:
     free = edmp.check(wall, wall_plan.waypoints)
     assert free and free.colliding_states == 0 and free.first_contact is None and free.states >= 50
@@ -209,6 +235,19 @@ def test_moveit_scene_and_request_import_and_plan(wall: edmp.Scene) -> None:
     np.testing.assert_allclose(posed.goal.position, [0.48748365, -0.3335055, 0.25502735], atol=1e-6)
     alone = edmp.import_moveit(MOVEIT / "table_box.scene.yaml")
     np.testing.assert_array_equal(alone.goal, alone.start)
+
+
+def test_moveit_scene_of_another_arm_names_its_arm() -> None:
+    names = edmp.joint_names("xarm6")
+    start, goal = [0.0, -0.5, -0.8, 0.0, 1.3, 0.0], [0.5, -0.5, -0.8, 0.0, 1.3, 0.0]
+    scene_yaml = f"robot_state:\n  joint_state:\n    name: [{', '.join(names)}]\n    position: {start}\n"
+    goals = "".join(f"  - {{joint_name: {n}, position: {x}}}\n" for n, x in zip(names, goal))
+    request_yaml = f"group_name: xarm6\ngoal_constraints:\n- joint_constraints:\n{goals}"
+    scene = edmp.import_moveit(scene_yaml, request_yaml)
+    assert scene.robot == "xarm6"
+    np.testing.assert_allclose(scene.start, start)
+    with pytest.raises(edmp.SceneError, match="group_name"):
+        edmp.import_moveit(scene_yaml, request_yaml.replace("xarm6", "panda_arm"))
 
 
 def test_moveit_meshes_become_mesh_obstacles() -> None:

@@ -21,6 +21,7 @@ import torch
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from model import T, TemporalUNet, fake_quantized, is_quantized, schedule  # noqa: E402
+from shards import load_data  # noqa: E402
 
 
 def load(directory):
@@ -36,7 +37,7 @@ def load(directory):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", required=True, help="the gen-data .npy the prior was trained on")
+    ap.add_argument("--data", required=True, help="the gen-data .npy (or shards folder) the prior was trained on")
     ap.add_argument("--weights", default=HERE)
     ap.add_argument("--out", default=os.path.join(HERE, "..", "..", "tests", "fixtures", "prior_parity.json"))
     ap.add_argument("--seed", type=int, default=20261124)
@@ -45,7 +46,7 @@ def main():
     torch.manual_seed(args.seed)
     model = load(args.weights)
     fq = fake_quantized(model)
-    data = np.load(args.data, mmap_mode="r")
+    data = load_data(args.data)
     _, _, alpha_bars = schedule()
 
     steps = [1, 2, 10, 64, 128, 200, 254, 255]

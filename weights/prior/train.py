@@ -23,11 +23,12 @@ import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from model import HORIZON, T, BETA_MAX, TemporalUNet, schedule  # noqa: E402
+from shards import load_data  # noqa: E402
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", required=True, help="(N, 50, J) float32 .npy from edmp-host gen-data (J: the arm's joints)")
+    ap.add_argument("--data", required=True, help="(N, 50, J) float32 .npy from edmp-host gen-data (J: the arm's joints), or a folder of shards from shards.py")
     ap.add_argument("--out", default=os.path.dirname(os.path.abspath(__file__)))
     ap.add_argument("--dims", default="16,32,64")
     ap.add_argument("--no-top-skip", action="store_true", help="leave the full-resolution skip unused, as the original")
@@ -38,6 +39,7 @@ def main():
     ap.add_argument("--holdout", type=int, default=2000, help="last N trajectories: held-out loss")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=0, help="torch threads (0: torch's default)")
+    ap.add_argument("--init", help="a folder with a prior.safetensors of the same shape: train on from its weights")
     args = ap.parse_args()
 
     torch.manual_seed(args.seed)
@@ -46,7 +48,7 @@ def main():
         torch.set_num_threads(args.threads)
     device = "cuda" if torch.cuda.is_available() else "cpu"
 
-    data = np.load(args.data)
+    data = load_data(args.data)
     if data.ndim != 3 or data.shape[1] != HORIZON or data.shape[2] < 1:
         sys.exit(f"{args.data}: expected (N, {HORIZON}, J), got {data.shape}")
     joints = data.shape[2]
@@ -56,6 +58,14 @@ def main():
     dims = tuple(int(d) for d in args.dims.split(","))
     model = TemporalUNet(dims, top_skip=not args.no_top_skip, joints=joints).to(device)
     ema = TemporalUNet(dims, top_skip=not args.no_top_skip, joints=joints).to(device)
+    if args.init:
+        from safetensors.torch import load_file
+
+        model.load_state_dict(load_file(os.path.join(args.init, "prior.safetensors")))
+        # Read now: --out may be the same folder, and the first export overwrites it.
+        with open(os.path.join(args.init, "train_log.json")) as f:
+            before = json.load(f)
+        args.init_log = {k: before.get(k) for k in ("command", "steps", "elapsed_s", "held_out_loss", "init")}
     ema.load_state_dict(model.state_dict())
     for p in ema.parameters():
         p.requires_grad_(False)
@@ -162,6 +172,7 @@ def export(ema, args, log, elapsed, params, n):
                 "threads": torch.get_num_threads(),
                 "device": "cuda" if torch.cuda.is_available() else "cpu",
                 "held_out_loss": log["held"][-1] if log["held"] else None,
+                "init": getattr(args, "init_log", None),
                 "loss": log,
             },
             f,

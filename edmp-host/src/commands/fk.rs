@@ -3,8 +3,8 @@
 
 use crate::arm::{Arm, with_arm};
 use edmp_core::Error;
-use edmp_core::robot::kinematics::{Joints, Pose, forward};
-use edmp_core::robot::{PANDA, Robot};
+use edmp_core::robot::Robot;
+use edmp_core::robot::kinematics::{Pose, forward};
 use serde::Serialize;
 
 /// Arguments of `edmp-host fk`.
@@ -77,10 +77,10 @@ pub fn run(args: &Args) -> Result<(), String> {
     Ok(())
 }
 
-/// The `--json` document for `q` (what `edmp-host fk --json` prints): the one writer of it,
-/// which the Python package's `fk` shares.
-pub fn document(q: &Joints<f32>) -> Result<serde_json::Value, Error> {
-    let report = report(&PANDA, q)?;
+/// The `--json` document for `robot` at `q` (what `edmp-host fk --json` prints): the one
+/// writer of it, which the Python package's `fk` shares.
+pub fn document<const J: usize>(robot: &'static Robot<f32, J>, q: &[f32; J]) -> Result<serde_json::Value, Error> {
+    let report = report(robot, q)?;
     Ok(serde_json::to_value(&report).unwrap_or(serde_json::Value::Null))
 }
 

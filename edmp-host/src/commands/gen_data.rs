@@ -10,6 +10,7 @@
 //! solutions and its neutral configuration), within its limits and collision-free by the exact
 //! checker with 0.01 rad interpolation (the planner checks it).
 //! Output: one `.npy` file, float32, shape (count, 50, J), which `numpy.load` reads as is.
+//! With `--environments` it is one shard of a run split over workers (`weights/prior/shards.py`).
 
 use crate::arm::{Arm, with_arm};
 use crate::rrt::{RrtConfig, path_length, plan};
@@ -28,9 +29,14 @@ use std::time::Instant;
 /// Arguments of `edmp-host gen-data`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// How many trajectories to write.
+    /// How many trajectories to write: environments run until there are this many.
+    #[arg(long, required_unless_present = "environments", conflicts_with = "environments")]
+    problems: Option<usize>,
+    /// Instead of `--problems`: exactly this many environments (seeds `seed..seed + N`), and
+    /// every trajectory they give. One shard of a run split over workers
+    /// (`weights/prior/shards.py`): disjoint seed ranges give disjoint data.
     #[arg(long)]
-    problems: usize,
+    environments: Option<u64>,
     /// First environment seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -53,6 +59,15 @@ fn family_of(seed: u64) -> Family {
         3 => Family::MergedCubby,
         _ => Family::Dresser,
     }
+}
+
+/// When a run stops.
+#[derive(Clone, Copy)]
+enum Until {
+    /// This many trajectories (the last environment's extra ones dropped).
+    Trajectories(usize),
+    /// This many environments, all their trajectories kept (a shard).
+    Environments(u64),
 }
 
 /// What one environment gave.
@@ -138,24 +153,47 @@ pub fn run(args: &Args) -> Result<(), String> {
 
 fn generate<const J: usize>(robot: &'static Robot<f32, J>, args: &Args) -> Result<(), String> {
     let began = Instant::now();
-    let bar = ProgressBar::new(args.problems as u64);
+    let until = match (args.problems, args.environments) {
+        (Some(n), _) => Until::Trajectories(n),
+        (None, Some(e)) => Until::Environments(e),
+        (None, None) => return Err("give --problems or --environments".into()),
+    };
+    let (total, unit) = match until {
+        Until::Trajectories(n) => (n as u64, "trajectories"),
+        Until::Environments(e) => (e, "environments"),
+    };
+    let bar = ProgressBar::new(total);
     bar.set_style(
-        ProgressStyle::with_template("[{bar:40}] {pos}/{len} trajectories, {elapsed} elapsed, {per_sec}, eta {eta}")
-            .map_err(|e| e.to_string())?
-            .progress_chars("=> "),
+        ProgressStyle::with_template(&format!(
+            "[{{bar:40}}] {{pos}}/{{len}} {unit}, {{elapsed}} elapsed, {{per_sec}}, eta {{eta}}"
+        ))
+        .map_err(|e| e.to_string())?
+        .progress_chars("=> "),
     );
-    let (mut data, mut failures, mut environments) = (Vec::with_capacity(args.problems), 0usize, 0u64);
+    let (mut data, mut failures, mut environments) = (Vec::new(), 0usize, 0u64);
     let batch = 2 * rayon::current_num_threads() as u64;
-    while data.len() < args.problems {
-        let seeds: Vec<u64> = (environments..environments + batch).map(|e| args.seed + e).collect();
-        environments += batch;
+    loop {
+        let end = match until {
+            Until::Trajectories(n) if data.len() >= n => break,
+            Until::Trajectories(_) => environments + batch,
+            Until::Environments(e) if environments >= e => break,
+            Until::Environments(e) => (environments + batch).min(e),
+        };
+        let seeds: Vec<u64> = (environments..end).map(|e| args.seed + e).collect();
+        environments = end;
         let harvests: Vec<Harvest<J>> = seeds.par_iter().map(|&s| harvest(robot, s)).collect();
         for h in harvests {
             failures += h.failures;
-            let room = args.problems - data.len();
+            let room = match until {
+                Until::Trajectories(n) => n - data.len(),
+                Until::Environments(_) => usize::MAX,
+            };
             data.extend(h.trajectories.into_iter().take(room));
         }
-        bar.set_position(data.len() as u64);
+        bar.set_position(match until {
+            Until::Trajectories(_) => data.len() as u64,
+            Until::Environments(_) => environments,
+        });
     }
     bar.finish();
     write_npy(&args.out, &data).map_err(|e| format!("{}: {e}", args.out.display()))?;

@@ -3,8 +3,7 @@
 //! scene reader before anything is written.
 
 use crate::Failure;
-use crate::formats::json::parse_problem;
-use crate::formats::moveit::{Source, import};
+use crate::formats::moveit::{Source, import, validate};
 use std::path::PathBuf;
 
 /// Arguments of `edmp-host import-moveit`.
@@ -37,8 +36,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             Failure::Input(format!("{}: {}: {}", file.display(), e.path, e.message))
         }
     })?;
-    parse_problem(&doc.to_string())
-        .map_err(|e| Failure::Input(format!("the imported edmp-scene/1 is not valid: {e}")))?;
+    validate(&doc).map_err(Failure::Input)?;
     let text = serde_json::to_string_pretty(&doc).map_err(|e| Failure::Input(e.to_string()))? + "\n";
     match &args.output {
         Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display()))),

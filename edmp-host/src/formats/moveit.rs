@@ -3,51 +3,60 @@
 //! files) and optionally a `moveit_msgs/MotionPlanRequest` (YAML) become one document,
 //! validated through the host's JSON reader.
 //!
-//! What is read: `world.collision_objects[]` (BOX, SPHERE, CYLINDER primitives; the pose of each
-//! is its frame's, times the object's `pose`, times the primitive's pose), one object attached
-//! to `panda_hand` with one primitive (the held object), the start from the request's
-//! `start_state.joint_state` (else the scene's `robot_state.joint_state`), and the goal from
-//! `goal_constraints[0]`: joint constraints, or one position and one orientation constraint on
-//! `panda_link8`, `panda_hand` or `panda_grasptarget` (converted to the TCP). ROS quaternions
-//! are `{x, y, z, w}`; ours are `[w, x, y, z]`. Points and quaternions may also be flow
-//! sequences (`[x, y, z]`, `[x, y, z, w]`) and primitive types names (`box`, `sphere`,
-//! `cylinder`), as robowflex writes them; an operation is ADD as `0`, `"\x00"`, `b'\x00'`,
-//! `add`, or absent.
+//! The arm. `robot_model_name` names it (`panda`; `iiwa7` or its URDF's `lbr_iiwa`; `xarm6`);
+//! without one, the first joint name of the robot states or the joint goal does
+//! (`panda_joint1`, `lbr_iiwa_joint_1`, `joint1`); with neither, it is the Panda. Everything
+//! below then uses that arm's names: its base link (`panda_link0`, `lbr_iiwa_link_0`,
+//! `link_base`), its hand (`panda_hand`; the others' TCP link, `lbr_iiwa_link_7`, `link6`),
+//! its joints and its planning groups (`panda_arm`, `panda_manipulator`; `manipulator`,
+//! `iiwa7`; `xarm6`). A document for another arm carries `robot`.
 //!
-//! Frames. Our world is `panda_link0`, the Panda's base. MoveIt's planning frame is `world`;
-//! an absent header or an empty `frame_id` names it. Where it is relative to the base:
+//! What is read: `world.collision_objects[]` (BOX, SPHERE, CYLINDER primitives, and meshes; the
+//! pose of each is its frame's, times the object's `pose`, times the primitive's pose), one
+//! object attached to the hand with one primitive (the held object), the start from the
+//! request's `start_state.joint_state` (else the scene's `robot_state.joint_state`), and the
+//! goal from `goal_constraints[0]`: joint constraints, or one position and one orientation
+//! constraint on a link rigid with the TCP (the Panda's `panda_link8`, `panda_hand` or
+//! `panda_grasptarget`; another arm's TCP link), converted to the TCP. ROS quaternions are
+//! `{x, y, z, w}`; ours are `[w, x, y, z]`. Points and quaternions may also be flow sequences
+//! (`[x, y, z]`, `[x, y, z, w]`) and primitive types names (`box`, `sphere`, `cylinder`), as
+//! robowflex writes them; an operation is ADD as `0`, `"\x00"`, `b'\x00'`, `add`, or absent.
+//!
+//! Frames. Our world is the arm's base link. MoveIt's planning frame is `world`; an absent
+//! header or an empty `frame_id` names it. Where it is relative to the base:
 //! - `multi_dof_joint_state` (the scene's robot state, or the request's start state, which wins
 //!   as MoveIt merges it): at most one joint, of any name (MoveIt's Panda: `virtual_joint`),
-//!   its parent the planning frame; its transform places `panda_link0` in `world`, and everything
-//!   given in `world` is brought into the base frame by its inverse. Within 1e-9 of the
-//!   identity it is the identity. Its twist and wrench, and joint velocities and efforts, are
-//!   ignored: a plan is positions. A second multi-DOF joint is an error.
-//! - no such joint: `world` is `panda_link0`.
+//!   its parent the planning frame; its transform places the base link in `world`, and
+//!   everything given in `world` is brought into the base frame by its inverse. Within 1e-9 of
+//!   the identity it is the identity. Its twist and wrench, and joint velocities and efforts,
+//!   are ignored: a plan is positions. A second multi-DOF joint is an error.
+//! - no such joint: `world` is the base link.
 //! - `fixed_frame_transforms` (`geometry_msgs/TransformStamped`, parent the header's frame, empty
 //!   the planning frame): each child is a frame that objects and goal constraints may name; one
-//!   the importer already places (`world`, `panda_link0`) must agree with it to 1e-6 (an
-//!   identity `world` → `panda_link0` does, with no or an identity virtual joint); a robot link
-//!   other than the base is an error (the joint state places it).
+//!   the importer already places (`world`, the base link) must agree with it to 1e-6 (an
+//!   identity `world` → base does, with no or an identity virtual joint); a robot link other
+//!   than the base is an error (the joint state places it).
 //!
-//! An attached object's frame is `panda_hand`, or empty (its link's, as MoveIt reads it); an
+//! An attached object's frame is the hand, or empty (its link's, as MoveIt reads it); an
 //! attached object without a header is refused (robowflex would read it as `world`).
 //!
 //! Everything that would change the problem and cannot be expressed is an error naming its YAML
-//! path: planes, cones, meshes (read and checked by `mesh`, then refused until the scene
-//! reader takes mesh obstacles; mesh files by `resource` are refused), octomap data, unknown
-//! frames and links, padding ≠ 0 or scale ≠ 1, operations other than ADD, path constraints, a
-//! second goal. Fields that do not change the geometry or the ends are read and ignored: names,
-//! stamps, `is_diff`, `robot_model_name` (`panda` or empty), colours, subframes, object types,
-//! planner settings, and the allowed collision matrix (it only ever permits contacts; the
-//! checker checks every pair the spec names). Unknown fields are errors, as in `edmp-scene/1`.
+//! path: planes, cones, mesh files by `resource`, octomap data, unknown frames and links,
+//! padding ≠ 0 or scale ≠ 1, operations other than ADD, path constraints, a second goal.
+//! Fields that do not change the geometry or the ends are read and ignored: names, stamps,
+//! `is_diff`, colours, subframes, object types, planner settings, and the allowed collision
+//! matrix (it only ever permits contacts; the checker checks every pair the spec names).
+//! Unknown fields are errors, as in `edmp-scene/1`.
 
-use crate::formats::json::{Problem, parse_problem};
+use crate::arm::{Arm, with_arm};
+use crate::formats::json::{parse_problem_for, scene_arm};
 use core::fmt;
+use edmp_core::robot::Robot;
 use edmp_core::robot::kinematics::forward;
-use edmp_core::robot::{FRAME_NAMES, HAND_FRAME, JOINT_NAMES, JOINTS, TCP_FRAME};
 use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
 use saphyr::{LoadableYamlNode, Scalar, Yaml};
 use serde_json::{Map, Value, json};
+use std::path::Path;
 
 /// The finger opening `edmp-scene/1` holds when it has no `gripper` field (metres).
 const FINGER_OPENING: f64 = 0.025;
@@ -55,17 +64,117 @@ const FINGER_OPENING: f64 = 0.025;
 const FINGER_TOLERANCE: f64 = 1e-6;
 /// How far a quaternion's norm may be from 1 (the scene format's own rule).
 const NORM_TOLERANCE: f64 = 1e-3;
-/// Our world: the Panda's base link.
-const BASE_FRAME: &str = "panda_link0";
-/// MoveIt's planning frame (the Panda configuration's virtual joint's parent); an empty or
+/// MoveIt's planning frame (the arm configuration's virtual joint's parent); an empty or
 /// absent frame is this one.
 const PLANNING_FRAME: &str = "world";
 /// How far a virtual joint's transform may be from the identity and be read as it (m, rad).
 const IDENTITY_TOLERANCE: f64 = 1e-9;
 /// How far two placements of one frame may differ and still agree (m, rad).
 const AGREEMENT_TOLERANCE: f64 = 1e-6;
-/// Finger joints: one opening for the whole plan (`gripper.finger`).
-const FINGER_JOINTS: [&str; 2] = ["panda_finger_joint1", "panda_finger_joint2"];
+/// What the importer needs to know of an arm: its names as its URDF and its MoveIt
+/// configuration write them.
+#[derive(Clone, Copy, Debug)]
+struct ArmNames {
+    arm: Arm,
+    /// The arm's joints, joint 1 first.
+    joints: &'static [&'static str],
+    /// Every link frame of the generated tables.
+    frames: &'static [&'static str],
+    /// Our world: the base link, which a virtual joint places in the planning frame.
+    base: &'static str,
+    /// The link an attached object hangs from (the Panda's hand; another arm's TCP link).
+    hand: &'static str,
+    /// Finger joints: one opening for the whole plan (`gripper.finger`).
+    fingers: &'static [&'static str],
+    /// Links rigid with the TCP that a pose goal may name.
+    rigid: &'static [&'static str],
+    /// Planning groups a request may name (besides none).
+    groups: &'static [&'static str],
+    /// `robot_model_name`s that name this arm (the URDF's robot name, the scene format's name).
+    models: &'static [&'static str],
+}
+
+impl ArmNames {
+    fn of(arm: Arm) -> Self {
+        let (joints, frames, hand) =
+            with_arm!(arm, robot => (&robot.joint_names[..], robot.frame_names, robot.hand_frame));
+        let (base, fingers, rigid, groups, models): (_, &[&str], &[&str], &[&str], &[&str]) = match arm {
+            Arm::Panda => (
+                "panda_link0",
+                &["panda_finger_joint1", "panda_finger_joint2"],
+                &["panda_link8", "panda_hand", "panda_grasptarget"],
+                &["panda_arm", "panda_manipulator"],
+                &["panda"],
+            ),
+            // The MoveIt configurations of ROS-Industrial's iiwa_stack and of UFACTORY's
+            // xarm_ros name these groups.
+            Arm::Iiwa7 => (
+                "lbr_iiwa_link_0",
+                &[],
+                &["lbr_iiwa_link_7"],
+                &["manipulator", "iiwa7"],
+                &["iiwa7", "lbr_iiwa"],
+            ),
+            Arm::Xarm6 => ("link_base", &[], &["link6"], &["xarm6"], &["xarm6"]),
+        };
+        Self {
+            arm,
+            joints,
+            frames,
+            base,
+            hand: frames[hand],
+            fingers,
+            rigid,
+            groups,
+            models,
+        }
+    }
+
+    /// The arm of a scene and request: the one `robot_model_name` names, else the one whose
+    /// joints the first joint name (robot states, joint goals) belongs to, else the Panda.
+    /// The reader then refuses whatever does not fit it, by path.
+    fn detect(scene: &Value, request: Option<&Value>) -> Self {
+        let arms = Arm::ALL.map(Self::of);
+        if let Some(model) = scene.get("robot_model_name").and_then(Value::as_str)
+            && let Some(a) = arms.iter().find(|a| a.models.contains(&model))
+        {
+            return *a;
+        }
+        let state_names = |state: Option<&Value>| {
+            state
+                .and_then(|s| s.get("joint_state"))
+                .and_then(|j| j.get("name"))
+                .and_then(Value::as_array)
+                .cloned()
+                .unwrap_or_default()
+        };
+        let mut names = state_names(scene.get("robot_state"));
+        if let Some(r) = request {
+            names.extend(state_names(r.get("start_state")));
+            for g in r
+                .get("goal_constraints")
+                .and_then(Value::as_array)
+                .into_iter()
+                .flatten()
+            {
+                for c in g
+                    .get("joint_constraints")
+                    .and_then(Value::as_array)
+                    .into_iter()
+                    .flatten()
+                {
+                    names.extend(c.get("joint_name").cloned());
+                }
+            }
+        }
+        names
+            .iter()
+            .filter_map(Value::as_str)
+            .find_map(|n| arms.iter().find(|a| a.joints.contains(&n) || a.fingers.contains(&n)))
+            .copied()
+            .unwrap_or(arms[0])
+    }
+}
 
 /// Which of the two input files an error is in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -336,22 +445,24 @@ fn describe(p: &Isometry3<f64>) -> String {
     )
 }
 
-/// The frames objects and goals may name, each with its pose in our world (`panda_link0`, the
-/// Panda's base): the planning frame (`world`, or an empty frame), the base, and the children
-/// of `fixed_frame_transforms`.
+/// The frames objects and goals may name, each with its pose in our world (the arm's base
+/// link, `panda_link0` for the Panda): the planning frame (`world`, or an empty frame), the
+/// base, and the children of `fixed_frame_transforms`.
 #[derive(Debug)]
 struct Frames {
     known: Vec<(String, Isometry3<f64>)>,
+    arm: ArmNames,
 }
 
 impl Frames {
-    /// `base`: where the virtual joint places `panda_link0` in the planning frame.
-    fn new(base: &Isometry3<f64>) -> Self {
+    /// `base`: where the virtual joint places the arm's base link in the planning frame.
+    fn new(base: &Isometry3<f64>, arm: ArmNames) -> Self {
         Self {
             known: vec![
-                (BASE_FRAME.to_owned(), Isometry3::identity()),
+                (arm.base.to_owned(), Isometry3::identity()),
                 (PLANNING_FRAME.to_owned(), base.inverse()),
             ],
+            arm,
         }
     }
 
@@ -401,14 +512,15 @@ impl Frames {
                     return Err(at(
                         &tp,
                         format!(
-                            "places {:?} at {} in panda_link0, but it is at {} (the robot state's virtual joint places the base; the planning frame is world)",
+                            "places {:?} at {} in {}, but it is at {} (the robot state's virtual joint places the base; the planning frame is world)",
                             if child.is_empty() { PLANNING_FRAME } else { child },
                             describe(&placed),
+                            self.arm.base,
                             describe(known),
                         ),
                     ));
                 }
-            } else if FRAME_NAMES.contains(&child) {
+            } else if self.arm.frames.contains(&child) {
                 return Err(at(
                     &cp,
                     format!("{child:?} is a robot link: the joint state places it, not a fixed transform"),
@@ -566,11 +678,12 @@ const COLLISION_OBJECT: [&str; 13] = [
     "operation",
 ];
 
-/// Where a collision object's frame is: our world's `frames`, or (attached objects) the hand.
+/// Where a collision object's frame is: our world's `frames`, or (attached objects) the hand
+/// (the Panda's; another arm's TCP link).
 #[derive(Clone, Copy)]
 enum ObjectFrames<'a> {
     World(&'a Frames),
-    Hand,
+    Hand(&'static str),
 }
 
 /// A `moveit_msgs/CollisionObject`: its primitives, placed in our world (or, for an attached
@@ -583,18 +696,20 @@ fn collision_object(v: &Value, path: &str, frames: ObjectFrames<'_>) -> R<(Strin
         ObjectFrames::World(frames) => frames.pose(&fid, &join(path, "header.frame_id"))?,
         // No header at all: ROS reads an empty frame (for an attached object, its link's),
         // robowflex `world`. Not guessed.
-        ObjectFrames::Hand if map.is_none_or(|m| !m.contains_key("header")) => {
+        ObjectFrames::Hand(hand) if map.is_none_or(|m| !m.contains_key("header")) => {
             return Err(at(
                 path,
-                "no header: an attached object's frame is ambiguous without one (ROS reads its link's, MotionBenchMaker's robowflex world); give header.frame_id panda_hand",
+                format!(
+                    "no header: an attached object's frame is ambiguous without one (ROS reads its link's, MotionBenchMaker's robowflex world); give header.frame_id {hand}"
+                ),
             ));
         }
         // MoveIt reads an attached object's empty frame as its link's.
-        ObjectFrames::Hand if fid.is_empty() || fid == FRAME_NAMES[HAND_FRAME] => Isometry3::identity(),
-        ObjectFrames::Hand => {
+        ObjectFrames::Hand(hand) if fid.is_empty() || fid == hand => Isometry3::identity(),
+        ObjectFrames::Hand(hand) => {
             return Err(at(
                 &join(path, "header.frame_id"),
-                format!("frame {fid:?} is not supported (only panda_hand, or empty)"),
+                format!("frame {fid:?} is not supported (only {hand}, or empty)"),
             ));
         }
     };
@@ -640,9 +755,9 @@ fn collision_object(v: &Value, path: &str, frames: ObjectFrames<'_>) -> R<(Strin
     Ok((id, out))
 }
 
-/// `moveit_msgs/AttachedCollisionObject`s: at most one, on `panda_hand`, with one primitive
-/// (the held object, in the hand frame).
-fn attached(items: &[Value], path: &str) -> R<Option<(String, Value)>> {
+/// `moveit_msgs/AttachedCollisionObject`s: at most one, on the arm's hand (`panda_hand`; another
+/// arm's TCP link), with one primitive (the held object, in that frame).
+fn attached(items: &[Value], path: &str, arm: &ArmNames) -> R<Option<(String, Value)>> {
     let mut held = None;
     for (i, item) in items.iter().enumerate() {
         let ip = format!("{path}[{i}]");
@@ -652,10 +767,10 @@ fn attached(items: &[Value], path: &str) -> R<Option<(String, Value)>> {
             &["link_name", "object", "touch_links", "detach_posture", "weight"],
         )?;
         let link = string(map, &ip, "link_name")?;
-        if link != FRAME_NAMES[HAND_FRAME] {
+        if link != arm.hand {
             return Err(at(
                 &join(&ip, "link_name"),
-                format!("attached to {link:?}: only objects held by panda_hand are supported"),
+                format!("attached to {link:?}: only objects held by {} are supported", arm.hand),
             ));
         }
         if held.is_some() {
@@ -665,7 +780,7 @@ fn attached(items: &[Value], path: &str) -> R<Option<(String, Value)>> {
         let (id, mut prims) = collision_object(
             map.and_then(|m| m.get("object")).unwrap_or(&Value::Null),
             &op,
-            ObjectFrames::Hand,
+            ObjectFrames::Hand(arm.hand),
         )?;
         if prims.len() != 1 {
             return Err(at(
@@ -691,21 +806,21 @@ type Fingers = Vec<(f64, String)>;
 /// What a `moveit_msgs/RobotState` holds for us.
 #[derive(Debug, Default)]
 struct State {
-    joints: Option<[f64; JOINTS]>,
+    joints: Option<Vec<f64>>,
     held: Option<(String, Value)>,
     fingers: Fingers,
-    /// Where the virtual joint places `panda_link0` in the planning frame, if it is given.
+    /// Where the virtual joint places the base link in the planning frame, if it is given.
     base: Option<Isometry3<f64>>,
 }
 
-fn robot_state(v: &Value, path: &str) -> R<State> {
+fn robot_state(v: &Value, path: &str, arm: &ArmNames) -> R<State> {
     let map = mapping(v, path, &ROBOT_STATE)?;
     let base = base_placement(
         map.and_then(|m| m.get("multi_dof_joint_state")).unwrap_or(&Value::Null),
         &join(path, "multi_dof_joint_state"),
     )?;
     let (items, ap) = sequence(map, path, "attached_collision_objects")?;
-    let held = attached(items, &ap)?;
+    let held = attached(items, &ap, arm)?;
     let jp = join(path, "joint_state");
     let js = mapping(
         map.and_then(|m| m.get("joint_state")).unwrap_or(&Value::Null),
@@ -727,17 +842,17 @@ fn robot_state(v: &Value, path: &str) -> R<State> {
             format!("{} positions for {} names", positions.len(), names.len()),
         ));
     }
-    let mut joints = [None; JOINTS];
+    let mut joints = vec![None; arm.joints.len()];
     let mut fingers = Vec::new();
     for (i, (name, value)) in names.iter().zip(positions).enumerate() {
         let name = name
             .as_str()
             .ok_or_else(|| at(&format!("{np}[{i}]"), "expected a joint name"))?;
         let x = number(value, &format!("{pp}[{i}]"))?;
-        assign(&mut joints, &mut fingers, name, x, &format!("{np}[{i}]"))?;
+        assign(arm, &mut joints, &mut fingers, name, x, &format!("{np}[{i}]"))?;
     }
     Ok(State {
-        joints: Some(complete(joints, &np)?),
+        joints: Some(complete(arm, joints, &np)?),
         held,
         fingers,
         base,
@@ -745,7 +860,7 @@ fn robot_state(v: &Value, path: &str) -> R<State> {
 }
 
 /// A `sensor_msgs/MultiDOFJointState`: at most one joint (any name; MoveIt's Panda calls it
-/// `virtual_joint`), whose transform places `panda_link0` in the planning frame. Its twist and
+/// `virtual_joint`), whose transform places the arm's base link in the planning frame. Its twist and
 /// wrench are ignored (a plan is positions; MoveIt's planners ignore start velocities too).
 fn base_placement(v: &Value, path: &str) -> R<Option<Isometry3<f64>>> {
     let map = mapping(v, path, &["header", "joint_names", "transforms", "twist", "wrench"])?;
@@ -763,7 +878,7 @@ fn base_placement(v: &Value, path: &str) -> R<Option<Isometry3<f64>>> {
         _ => {
             return Err(at(
                 &format!("{np}[1]"),
-                "a second multi-DOF joint: the Panda has one, the virtual joint that places its base",
+                "a second multi-DOF joint: an arm has one, the virtual joint that places its base",
             ));
         }
     }
@@ -792,49 +907,70 @@ fn base_placement(v: &Value, path: &str) -> R<Option<Isometry3<f64>>> {
 }
 
 /// Records joint `name` = `x` (a finger's opening goes to `fingers`, with its path).
-fn assign(joints: &mut [Option<f64>; JOINTS], fingers: &mut Fingers, name: &str, x: f64, path: &str) -> R<()> {
-    if let Some(j) = JOINT_NAMES.iter().position(|n| *n == name) {
-        if joints[j].replace(x).is_some() {
+fn assign(arm: &ArmNames, joints: &mut [Option<f64>], fingers: &mut Fingers, name: &str, x: f64, path: &str) -> R<()> {
+    if let Some(slot) = arm
+        .joints
+        .iter()
+        .position(|n| *n == name)
+        .and_then(|j| joints.get_mut(j))
+    {
+        if slot.replace(x).is_some() {
             return Err(at(path, format!("{name} given twice")));
         }
         Ok(())
-    } else if FINGER_JOINTS.contains(&name) {
+    } else if arm.fingers.contains(&name) {
         fingers.push((x, path.to_owned()));
         Ok(())
     } else {
+        let fingers = if arm.fingers.is_empty() { "" } else { " and the fingers" };
         Err(at(
             path,
-            format!("unknown joint {name:?} (panda_joint1..7 and the fingers)"),
+            format!(
+                "unknown joint {name:?} ({}'s joints are {}{fingers})",
+                arm.arm,
+                arm.joints.join(", ")
+            ),
         ))
     }
 }
 
-fn complete(joints: [Option<f64>; JOINTS], path: &str) -> R<[f64; JOINTS]> {
-    let mut out = [0.0; JOINTS];
-    for (j, (slot, q)) in out.iter_mut().zip(joints).enumerate() {
-        *slot = q.ok_or_else(|| at(path, format!("{} is missing", JOINT_NAMES[j])))?;
-    }
-    Ok(out)
+fn complete(arm: &ArmNames, joints: Vec<Option<f64>>, path: &str) -> R<Vec<f64>> {
+    joints
+        .into_iter()
+        .zip(arm.joints)
+        .map(|(q, name)| q.ok_or_else(|| at(path, format!("{name} is missing"))))
+        .collect()
 }
 
 /// Links rigidly attached to the TCP that a pose goal may name, and their TCP offset.
-fn tcp_offset(link: &str, path: &str) -> R<Isometry3<f64>> {
-    // After joint 7 nothing moves (the fingers are held): these frames are rigid with the TCP.
-    let rigid = ["panda_link8", FRAME_NAMES[HAND_FRAME], FRAME_NAMES[TCP_FRAME]];
-    let frame = rigid
+fn tcp_offset(arm: &ArmNames, link: &str, path: &str) -> R<Isometry3<f64>> {
+    // After the last joint nothing moves (the Panda's fingers are held): these frames are
+    // rigid with the TCP.
+    let frame = arm
+        .rigid
         .contains(&link)
-        .then(|| FRAME_NAMES.iter().position(|n| *n == link))
+        .then(|| arm.frames.iter().position(|n| *n == link))
         .flatten()
         .ok_or_else(|| {
             at(
                 path,
                 format!(
                     "link {link:?} is not supported for a pose goal (one of {})",
-                    rigid.join(", ")
+                    arm.rigid.join(", ")
                 ),
             )
         })?;
-    let k = forward(&edmp_core::robot::PANDA_F64, &[0.0; JOINTS]).map_err(|e| at(path, e.to_string()))?;
+    let offset = match arm.arm {
+        Arm::Panda => frame_to_tcp(&edmp_core::robot::arms::panda::ROBOT_F64, frame),
+        Arm::Iiwa7 => frame_to_tcp(&edmp_core::robot::arms::iiwa7::ROBOT_F64, frame),
+        Arm::Xarm6 => frame_to_tcp(&edmp_core::robot::arms::xarm6::ROBOT_F64, frame),
+    };
+    offset.ok_or_else(|| at(path, format!("link {link:?}: no forward kinematics at zero")))
+}
+
+/// Frame `frame`'s pose to the TCP's, at the zero configuration (they are rigid).
+fn frame_to_tcp<const J: usize>(robot: &'static Robot<f64, J>, frame: usize) -> Option<Isometry3<f64>> {
+    let k = forward(robot, &[0.0; J]).ok()?;
     let iso = |p: &edmp_core::robot::kinematics::Pose<f64>| {
         let r = Rotation3::from_matrix_unchecked(Matrix3::from(p.rotation));
         Isometry3::from_parts(
@@ -842,7 +978,7 @@ fn tcp_offset(link: &str, path: &str) -> R<Isometry3<f64>> {
             UnitQuaternion::from_rotation_matrix(&r),
         )
     };
-    Ok(iso(&k.frames[frame]).inverse() * iso(&k.frames[TCP_FRAME]))
+    Some(iso(k.frames.get(frame)?).inverse() * iso(k.frames.get(robot.tcp_frame)?))
 }
 
 /// The fields of `moveit_msgs/Constraints` (a goal, or the path constraints).
@@ -856,6 +992,7 @@ const CONSTRAINTS: [&str; 5] = [
 
 /// The goal of `moveit_msgs/Constraints`: joints (and finger openings), or the TCP pose.
 fn goal(v: &Value, path: &str, frames: &Frames) -> R<(Value, Fingers)> {
+    let arm = &frames.arm;
     let map = mapping(v, path, &CONSTRAINTS)?;
     unsupported_if_any(map, path, "visibility_constraints", "visibility constraints")?;
     let (jc, jcp) = sequence(map, path, "joint_constraints")?;
@@ -865,7 +1002,7 @@ fn goal(v: &Value, path: &str, frames: &Frames) -> R<(Value, Fingers)> {
         if !pc.is_empty() || !oc.is_empty() {
             return Err(at(path, "joint and pose constraints together: give one kind"));
         }
-        let mut joints = [None; JOINTS];
+        let mut joints = vec![None; arm.joints.len()];
         let mut fingers = Vec::new();
         for (i, c) in jc.iter().enumerate() {
             let cp = format!("{jcp}[{i}]");
@@ -879,9 +1016,9 @@ fn goal(v: &Value, path: &str, frames: &Frames) -> R<(Value, Fingers)> {
                 m.and_then(|m| m.get("position")).unwrap_or(&Value::Null),
                 &join(&cp, "position"),
             )?;
-            assign(&mut joints, &mut fingers, name, x, &join(&cp, "joint_name"))?;
+            assign(arm, &mut joints, &mut fingers, name, x, &join(&cp, "joint_name"))?;
         }
-        return Ok((json!({"joints": complete(joints, &jcp)?}), fingers));
+        return Ok((json!({"joints": complete(arm, joints, &jcp)?}), fingers));
     }
     match (pc.len(), oc.len()) {
         (1, 1) => {}
@@ -926,7 +1063,7 @@ fn goal(v: &Value, path: &str, frames: &Frames) -> R<(Value, Fingers)> {
             format!("{olink:?}, but the position constraint is on {link:?}"),
         ));
     }
-    let offset = tcp_offset(link, &join(&pp, "link_name"))?;
+    let offset = tcp_offset(arm, link, &join(&pp, "link_name"))?;
     let point_offset = vector(
         pm.and_then(|m| m.get("target_point_offset")),
         &join(&pp, "target_point_offset"),
@@ -999,20 +1136,28 @@ fn link_adjustments(map: Option<&Map<String, Value>>, key: &str, neutral: f64) -
 /// The scene's obstacles (with their ids), its robot state, and its frames. `request_base`:
 /// the request's start state's virtual joint, which (as MoveIt merges a start state into the
 /// scene's) places the base instead of the scene's own.
-fn scene_part(v: &Value, request_base: Option<Isometry3<f64>>) -> R<(Vec<Value>, Vec<String>, State, Frames)> {
+fn scene_part(
+    v: &Value,
+    request_base: Option<Isometry3<f64>>,
+    arm: ArmNames,
+) -> R<(Vec<Value>, Vec<String>, State, Frames)> {
     let map = mapping(v, "", &PLANNING_SCENE)?;
     let model = string(map, "", "robot_model_name")?;
-    if !model.is_empty() && model != "panda" {
-        return Err(at("robot_model_name", format!("{model:?}: only the Panda (\"panda\")")));
+    if !model.is_empty() && !arm.models.contains(&model) {
+        let known: Vec<&str> = Arm::ALL.iter().flat_map(|a| ArmNames::of(*a).models).copied().collect();
+        return Err(at(
+            "robot_model_name",
+            format!("{model:?}: not an arm edmp-rs knows (one of {})", known.join(", ")),
+        ));
     }
     link_adjustments(map, "link_padding", 0.0)?;
     link_adjustments(map, "link_scale", 1.0)?;
     let state = match map.and_then(|m| m.get("robot_state")) {
-        Some(rs) => robot_state(rs, "robot_state")?,
+        Some(rs) => robot_state(rs, "robot_state", &arm)?,
         None => State::default(),
     };
     let base = request_base.or(state.base).unwrap_or_else(Isometry3::identity);
-    let mut frames = Frames::new(&base);
+    let mut frames = Frames::new(&base, arm);
     let (fixed, fp) = sequence(map, "", "fixed_frame_transforms")?;
     frames.read_fixed(fixed, &fp)?;
     let world = mapping(
@@ -1073,13 +1218,13 @@ const MOTION_PLAN_REQUEST: [&str; 16] = [
 ];
 
 /// The request's start state, after its checks (group, path and trajectory constraints).
-fn request_start(v: &Value) -> R<State> {
+fn request_start(v: &Value, arm: &ArmNames) -> R<State> {
     let map = mapping(v, "", &MOTION_PLAN_REQUEST)?;
     let group = string(map, "", "group_name")?;
-    if !["", "panda_arm", "panda_manipulator"].contains(&group) {
+    if !group.is_empty() && !arm.groups.contains(&group) {
         return Err(at(
             "group_name",
-            format!("{group:?}: only panda_arm or panda_manipulator"),
+            format!("{group:?}: {}'s groups are {}", arm.arm, arm.groups.join(", ")),
         ));
     }
     if let Some(pc) = map.and_then(|m| m.get("path_constraints")) {
@@ -1099,7 +1244,7 @@ fn request_start(v: &Value) -> R<State> {
     }
     unsupported_if_any(map, "", "reference_trajectories", "reference trajectories")?;
     match map.and_then(|m| m.get("start_state")) {
-        Some(s) => robot_state(s, "start_state"),
+        Some(s) => robot_state(s, "start_state", arm),
         None => Ok(State::default()),
     }
 }
@@ -1132,12 +1277,13 @@ pub fn import(scene_yaml: &str, request_yaml: Option<&str>) -> Result<Value, Imp
     };
     let scene_doc = load(scene_yaml).map_err(in_scene)?;
     let request_doc = request_yaml.map(load).transpose().map_err(in_request)?;
+    let arm = ArmNames::detect(&scene_doc, request_doc.as_ref());
     let request_state = match &request_doc {
-        Some(v) => Some(request_start(v).map_err(in_request)?),
+        Some(v) => Some(request_start(v, &arm).map_err(in_request)?),
         None => None,
     };
     let (obstacles, ids, scene_state, frames) =
-        scene_part(&scene_doc, request_state.as_ref().and_then(|s| s.base)).map_err(in_scene)?;
+        scene_part(&scene_doc, request_state.as_ref().and_then(|s| s.base), arm).map_err(in_scene)?;
     let request = match (request_state, &request_doc) {
         (Some(state), Some(v)) => Some((state, request_goal(v, &frames).map_err(in_request)?)),
         _ => None,
@@ -1185,7 +1331,8 @@ pub fn import(scene_yaml: &str, request_yaml: Option<&str>) -> Result<Value, Imp
                 message: "no start: give a request with a start_state, or a joint state here".into(),
             })?;
             let fingers = tag(scene_state.fingers, Source::Scene);
-            (start, json!({"joints": start}), scene_state.held, fingers)
+            let goal = json!({ "joints": start });
+            (start, goal, scene_state.held, fingers)
         }
     };
     // Both fingers, at the start and the goal: one opening for the whole plan.
@@ -1212,6 +1359,10 @@ pub fn import(scene_yaml: &str, request_yaml: Option<&str>) -> Result<Value, Imp
             "goal_from": if request_yaml.is_some() { "request" } else { "start (no request)" },
         },
     });
+    // Absent is the Panda: its documents stay as they were before other arms.
+    if arm.arm != Arm::Panda {
+        doc["robot"] = json!(arm.arm.name());
+    }
     if let Some(w) = opening.filter(|w| (w - FINGER_OPENING).abs() > FINGER_TOLERANCE) {
         doc["gripper"] = json!({ "finger": w });
     }
@@ -1222,13 +1373,21 @@ pub fn import(scene_yaml: &str, request_yaml: Option<&str>) -> Result<Value, Imp
     Ok(doc)
 }
 
-/// [`import`], then the document through the host's `edmp-scene/1` reader (the same checks
-/// as `edmp-host plan`: limits, valid ends, quaternions).
-pub fn import_validated(scene_yaml: &str, request_yaml: Option<&str>) -> Result<(Value, Problem), String> {
+/// Checks an imported document with the host's `edmp-scene/1` reader for the arm it names
+/// (the same checks as `edmp-host plan`: limits, valid ends, quaternions).
+pub fn validate(doc: &Value) -> Result<(), String> {
+    let text = doc.to_string();
+    let invalid = |e: String| format!("the imported edmp-scene/1 is not valid: {e}");
+    let arm = scene_arm(&text).map_err(|e| invalid(e.to_string()))?;
+    with_arm!(arm, robot => parse_problem_for(&text, Path::new("."), robot).map(|_| ()))
+        .map_err(|e| invalid(e.to_string()))
+}
+
+/// [`import`], then [`validate`].
+pub fn import_validated(scene_yaml: &str, request_yaml: Option<&str>) -> Result<Value, String> {
     let doc = import(scene_yaml, request_yaml).map_err(|e| e.to_string())?;
-    let problem =
-        parse_problem(&doc.to_string()).map_err(|e| format!("the imported edmp-scene/1 is not valid: {e}"))?;
-    Ok((doc, problem))
+    validate(&doc)?;
+    Ok(doc)
 }
 
 #[cfg(test)]

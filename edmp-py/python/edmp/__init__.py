@@ -13,8 +13,8 @@ CLI's ``edmp-plan/1`` document, parsed.
 
 A scene names its arm in ``robot`` (``"panda"`` when absent, ``"iiwa7"``, ``"xarm6"``); joint
 vectors then have that arm's joint count (:attr:`Scene.robot`). :func:`plan` plans for every
-arm, and so do :func:`check` and :func:`ik`; :func:`fk`, :func:`import_moveit` and the viewer
-run the Panda.
+arm, and so do :func:`check`, :func:`ik`, :func:`fk` (its ``robot`` argument) and
+:func:`import_moveit` (the arm its joint names name); the viewer runs the Panda.
 """
 
 from __future__ import annotations
@@ -47,6 +47,7 @@ __all__ = [
     "fk",
     "ik",
     "import_moveit",
+    "joint_names",
     "plan",
     "points_from_depth",
     "show",
@@ -441,11 +442,17 @@ def points_from_depth(
     return np.frombuffer(raw, dtype="<f4").reshape(-1, 3).astype(np.float64)
 
 
-def fk(q: ArrayLike) -> dict[str, Any]:
-    """Forward kinematics, as ``edmp-host fk --json``: ``tcp``, ``frames`` (13 link frames),
-    ``collision_boxes`` (11, with ``half_extents``), ``within_soft_limits``. Positions in metres,
-    quaternions ``[w, x, y, z]``, both as numpy arrays."""
-    report = json.loads(_edmp.fk(_vector(q, 7, "q")))
+def joint_names(robot: str = "panda") -> list[str]:
+    """The joint names of the arm called ``robot`` (a scene's ``robot`` names), joint 1 first."""
+    return list(_edmp.joint_names(robot))
+
+
+def fk(q: ArrayLike, robot: str = "panda") -> dict[str, Any]:
+    """Forward kinematics of ``robot`` at ``q``, as ``edmp-host fk --robot ROBOT --json``:
+    ``tcp``, ``frames`` (the link frames; the Panda's 13), ``collision_boxes`` (the Panda's 11,
+    with ``half_extents``), ``within_soft_limits``. Positions in metres, quaternions ``[w, x, y,
+    z]``, both as numpy arrays."""
+    report = json.loads(_edmp.fk(_vector(q, len(_edmp.joint_names(robot)), "q"), robot))
 
     def arrays(p: dict[str, Any]) -> dict[str, Any]:
         out = dict(p)
@@ -509,7 +516,8 @@ def import_moveit(
 ) -> Scene:
     """A MoveIt planning scene (``moveit_msgs/PlanningScene`` YAML) and optionally a motion
     plan request (``moveit_msgs/MotionPlanRequest`` YAML) as a :class:`Scene`, as
-    ``edmp-host import-moveit``. Each argument is YAML text or a path to a file. Unsupported
+    ``edmp-host import-moveit``. The arm is the one ``robot_model_name`` or the joint names
+    name (the Panda, the iiwa 7, the xArm 6). Each argument is YAML text or a path to a file. Unsupported
     entries (octomaps, point clouds, planes, other frames or links...) raise :class:`SceneError` naming their
     YAML path. Without a request the start is the scene's robot state and the goal equals it
     (set one with :meth:`Scene.with_goal`)."""
