@@ -14,7 +14,7 @@ use edmp_core::scene::QUATERNION_NORM_TOLERANCE;
 use edmp_host::Failure;
 use edmp_host::arm::Arm;
 use edmp_host::formats::json::{Goal, Problem, describe, joint_goal, parse_problem, parse_problem_for, scene_arm};
-use edmp_host::formats::plan::{add_trajectory, parse_plan, plan_document};
+use edmp_host::formats::plan::{add_trajectory, parse_plan_for, plan_document};
 use edmp_host::formats::trajectory::TimedRequest;
 use edmp_host::planning::{chosen_guides, plan_problem};
 use edmp_host::with_arm;
@@ -303,9 +303,19 @@ fn import_moveit(scene_yaml: &str, request_yaml: Option<&str>) -> PyResult<Strin
 #[pyfunction]
 #[pyo3(signature = (scene, plan = None, title = "edmp"))]
 fn view_page(scene: &str, plan: Option<&str>, title: &str) -> PyResult<String> {
-    let problem = parse(scene)?;
+    let arm = scene_arm(scene).map_err(scene_error)?;
+    with_arm!(arm, robot => view_page_for(scene, robot, plan, title))
+}
+
+fn view_page_for<const J: usize>(
+    scene: &str,
+    robot: &'static Robot<f32, J>,
+    plan: Option<&str>,
+    title: &str,
+) -> PyResult<String> {
+    let problem = parse_for(scene, robot)?;
     let plan = match plan {
-        Some(text) => Some(parse_plan(text).map_err(|e| PyValueError::new_err(format!("plan: {e}")))?),
+        Some(text) => Some(parse_plan_for::<J>(text).map_err(|e| PyValueError::new_err(format!("plan: {e}")))?),
         None => None,
     };
     edmp_host::commands::view::page(&problem, plan.as_ref(), title).map_err(PlanError::new_err)

@@ -14,7 +14,7 @@ CLI's ``edmp-plan/1`` document, parsed.
 A scene names its arm in ``robot`` (``"panda"`` when absent, ``"iiwa7"``, ``"xarm6"``); joint
 vectors then have that arm's joint count (:attr:`Scene.robot`). :func:`plan` plans for every
 arm, and so do :func:`check`, :func:`ik`, :func:`fk` (its ``robot`` argument) and
-:func:`import_moveit` (the arm its joint names name); the viewer runs the Panda.
+:func:`import_moveit` (the arm its joint names name) and :func:`show`.
 """
 
 from __future__ import annotations

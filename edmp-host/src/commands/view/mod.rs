@@ -1,20 +1,21 @@
 //! `edmp-host view`: a scene (and a plan) as one self-contained HTML page, an interactive 3-D
 //! viewer that opens offline in a browser (docs/viewer.md).
 //!
-//! Everything the page draws is computed here and embedded as JSON: the arm's visual meshes
-//! (the URDF's `<visual>` meshes with their origins), the obstacles (clouds and meshes as
+//! Everything the page draws is computed here and embedded as JSON: the scene's arm's meshes
+//! (the URDF's `<visual>` meshes with their origins; the xArm's `<collision>` meshes, its visual
+//! STL files not being shipped in `weights/`), the obstacles (clouds and meshes as
 //! base64 little-endian `f32`/`u32` arrays, a cloud thinned to [`MAX_VIEW_POINTS`] points in
 //! all), and for every sample of
 //! the animation the world pose of each link frame from the core's forward kinematics. The
 //! page's JavaScript (`page.js`, on the vendored three.js in `vendor/three`) only places meshes
 //! at those poses and interpolates between samples; it computes no kinematics.
 
-use crate::Failure;
-use crate::formats::json::{Goal, Problem, parse_problem_in};
-use crate::formats::plan::{PlanDocument, parse_plan};
+use crate::formats::json::{Goal, Problem, parse_problem_for, scene_arm};
+use crate::formats::plan::{PlanDocument, parse_plan_for};
 use crate::formats::surface::{SurfaceKind, SurfaceObstacle};
-use edmp_core::robot::kinematics::{Joints, Pose, forward_with};
-use edmp_core::robot::{FRAME_NAMES, FRAMES, HAND_FRAME, TCP_FRAME};
+use crate::{Failure, with_arm};
+use edmp_core::robot::Robot;
+use edmp_core::robot::kinematics::{Pose, forward_with};
 use edmp_core::scene::{Obstacle, Shape};
 use nalgebra::{Rotation3, UnitQuaternion};
 use serde_json::{Value, json};
@@ -32,12 +33,98 @@ pub struct Args {
     output: PathBuf,
 }
 
-/// The Panda's URDF: the visual meshes and their origins come from its `<visual>` elements.
-const URDF: &str = include_str!("../../../../weights/panda/panda.urdf");
+/// Where the meshes the page draws for an arm come from.
+struct Visuals {
+    /// The arm's scene-format name.
+    arm: &'static str,
+    /// The URDF's file name, for errors.
+    file: &'static str,
+    /// The URDF: the meshes and their origins come from its `<visual>` elements.
+    urdf: &'static str,
+    /// Draw the `<collision>` meshes instead (the visual ones are not shipped).
+    collision: bool,
+    /// The mesh files the URDF names, by their path (`package://` dropped): the OBJ text and
+    /// its MTL text (empty when the mesh has no colours of its own).
+    files: &'static [(&'static str, &'static str, &'static str)],
+}
 
-/// The mesh files the URDF's visuals name, by their `package://` path: the OBJ text and its
-/// MTL text (empty when the mesh has no colours of its own).
-const MESH_FILES: [(&str, &str, &str); 10] = [
+/// Every arm's meshes.
+const VISUALS: [Visuals; 3] = [
+    Visuals {
+        arm: "panda",
+        file: "panda.urdf",
+        urdf: include_str!("../../../../weights/panda/panda.urdf"),
+        collision: false,
+        files: &PANDA_FILES,
+    },
+    Visuals {
+        arm: "iiwa7",
+        file: "model.urdf",
+        urdf: include_str!("../../../../weights/iiwa7/model.urdf"),
+        collision: false,
+        files: &IIWA7_FILES,
+    },
+    Visuals {
+        arm: "xarm6",
+        file: "xarm6_robot.urdf",
+        urdf: include_str!("../../../../weights/xarm6/xarm6_robot.urdf"),
+        collision: true,
+        files: &XARM6_FILES,
+    },
+];
+
+/// The iiwa 7's visual meshes (pybullet_data's `kuka_iiwa/meshes`).
+const IIWA7_FILES: [(&str, &str, &str); 8] = {
+    macro_rules! link {
+        ($n:literal) => {
+            (
+                concat!("meshes/link_", $n, ".obj"),
+                include_str!(concat!("../../../../weights/iiwa7/meshes/link_", $n, ".obj")),
+                include_str!(concat!("../../../../weights/iiwa7/meshes/link_", $n, ".mtl")),
+            )
+        };
+    }
+    [
+        link!(0),
+        link!(1),
+        link!(2),
+        link!(3),
+        link!(4),
+        link!(5),
+        link!(6),
+        link!(7),
+    ]
+};
+
+/// The xArm 6's collision meshes (V-HACD pieces, uncoloured).
+const XARM6_FILES: [(&str, &str, &str); 7] = {
+    macro_rules! link {
+        ($n:literal) => {
+            (
+                concat!("xarm_description/meshes/xarm6/collision/", $n, "_vhacd.obj"),
+                include_str!(concat!(
+                    "../../../../weights/xarm6/xarm_description/meshes/xarm6/collision/",
+                    $n,
+                    "_vhacd.obj"
+                )),
+                "",
+            )
+        };
+    }
+    [
+        link!("base"),
+        link!("link1"),
+        link!("link2"),
+        link!("link3"),
+        link!("link4"),
+        link!("link5"),
+        link!("link6"),
+    ]
+};
+
+/// The Panda's meshes (visual ones, reduced by `scripts/visual-meshes`; two links have only
+/// collision meshes in PyBullet's package).
+const PANDA_FILES: [(&str, &str, &str); 10] = [
     (
         "meshes/collision/link0.obj",
         include_str!("../../../../weights/panda/meshes/collision/link0.obj"),
@@ -113,13 +200,23 @@ pub const MAX_VIEW_POINTS: usize = 100_000;
 /// Reads the scene (and plan), writes the page. Bad input: exit 2 naming the file and JSON path,
 /// nothing written.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let read =
-        |path: &Path| std::fs::read_to_string(path).map_err(|e| Failure::Input(format!("{}: {e}", path.display())));
     let text = read(&args.scene)?;
+    let arm = scene_arm(&text).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    with_arm!(arm, robot => write(args, &text, robot))
+}
+
+fn read(path: &Path) -> Result<String, Failure> {
+    std::fs::read_to_string(path).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))
+}
+
+fn write<const J: usize>(args: &Args, text: &str, robot: &'static Robot<f32, J>) -> Result<(), Failure> {
     let dir = args.scene.parent().unwrap_or(Path::new("."));
-    let problem = parse_problem_in(&text, dir).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
+    let problem =
+        parse_problem_for(text, dir, robot).map_err(|e| Failure::Input(format!("{}: {e}", args.scene.display())))?;
     let plan = match &args.plan {
-        Some(path) => Some(parse_plan(&read(path)?).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?),
+        Some(path) => {
+            Some(parse_plan_for::<J>(&read(path)?).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?)
+        }
         None => None,
     };
     let title = match &args.plan {
@@ -137,7 +234,11 @@ fn file_name(path: &Path) -> String {
 
 /// The HTML page of `problem` (and `plan`), titled `title`: the one writer of the viewer, which
 /// the CLI and the Python package share. Errors name the plan field the kinematics refused.
-pub fn page(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Result<String, String> {
+pub fn page<const J: usize>(
+    problem: &Problem<J>,
+    plan: Option<&PlanDocument<J>>,
+    title: &str,
+) -> Result<String, String> {
     let data = page_data(problem, plan, title)?;
     // `</` cannot end the data's script element once escaped (`\/` is a JSON escape of `/`).
     let data = serde_json::to_string(&data)
@@ -206,11 +307,17 @@ fn quaternion(rotation: &nalgebra::Matrix3<f32>) -> [f64; 4] {
 }
 
 /// One animation sample: the world pose of every link frame (`x y z qw qx qy qz` each, frames
-/// in `FRAME_NAMES` order, flattened) and the TCP position, from the core's FK.
-fn sample(q: &Joints<f32>, finger: f32, at: &str) -> Result<(Vec<f64>, [f64; 3]), String> {
-    let k = forward_with(&edmp_core::robot::PANDA, q, finger).map_err(|e| format!("{at}: {e}"))?;
-    let mut poses = Vec::with_capacity(FRAMES * 7);
-    for frame in &k.frames {
+/// in the arm's `frame_names` order, flattened) and the TCP position, from the core's FK.
+fn sample<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    q: &[f32; J],
+    finger: f32,
+    at: &str,
+) -> Result<(Vec<f64>, [f64; 3]), String> {
+    let k = forward_with(robot, q, finger).map_err(|e| format!("{at}: {e}"))?;
+    let frames = robot.frame_names.len();
+    let mut poses = Vec::with_capacity(frames * 7);
+    for frame in k.frames.iter().take(frames) {
         poses.extend(micro3(&frame.translation));
         poses.extend(frame.quaternion_wxyz().map(micro));
     }
@@ -220,7 +327,7 @@ fn sample(q: &Joints<f32>, finger: f32, at: &str) -> Result<(Vec<f64>, [f64; 3])
 /// The animated configurations and their times: the timed trajectory (thinned to at most
 /// `MAX_SAMPLE_RATE` per second) when the plan has one, else the waypoints `EVEN_STEP_S`
 /// apart, else the start alone. Each with the JSON path that names it in errors.
-fn timeline(problem: &Problem, plan: Option<&PlanDocument>) -> Vec<(f32, Joints<f32>, String)> {
+fn timeline<const J: usize>(problem: &Problem<J>, plan: Option<&PlanDocument<J>>) -> Vec<(f32, [f32; J], String)> {
     let Some(plan) = plan else {
         return vec![(0.0, problem.start, "start".to_string())];
     };
@@ -316,31 +423,41 @@ fn surfaces(obstacles: &[SurfaceObstacle]) -> Vec<Value> {
         .collect()
 }
 
-fn tcp_path(path: &[Joints<f32>], finger: f32, at: &str) -> Result<Vec<[f64; 3]>, String> {
+fn tcp_path<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    path: &[[f32; J]],
+    finger: f32,
+    at: &str,
+) -> Result<Vec<[f64; 3]>, String> {
     path.iter()
         .enumerate()
-        .map(|(i, q)| sample(q, finger, &format!("{at}[{i}]")).map(|(_, tcp)| tcp))
+        .map(|(i, q)| sample(robot, q, finger, &format!("{at}[{i}]")).map(|(_, tcp)| tcp))
         .collect()
 }
 
-fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Result<Value, String> {
-    let finger = problem.scene().gripper();
+fn page_data<const J: usize>(
+    problem: &Problem<J>,
+    plan: Option<&PlanDocument<J>>,
+    title: &str,
+) -> Result<Value, String> {
+    let robot = problem.robot;
+    let finger = robot.finger_opening(problem.scene().gripper());
     let mut times = Vec::new();
     let mut poses = Vec::new();
     let mut tcp = Vec::new();
     for (time, q, at) in timeline(problem, plan) {
-        let (p, t) = sample(&q, finger, &at)?;
+        let (p, t) = sample(robot, &q, finger, &at)?;
         times.push(micro(time));
         poses.push(p);
         tcp.push(t);
     }
-    let start_tcp = sample(&problem.start, finger, "start")?.1;
+    let start_tcp = sample(robot, &problem.start, finger, "start")?.1;
     let goal_tcp = match problem.goal {
-        Goal::Joints(q) => sample(&q, finger, "goal.joints")?.1,
+        Goal::Joints(q) => sample(robot, &q, finger, "goal.joints")?.1,
         Goal::Pose { position, .. } => position.map(micro),
     };
     let waypoints_tcp = match plan {
-        Some(plan) => tcp_path(&plan.waypoints, finger, "waypoints")?,
+        Some(plan) => tcp_path(robot, &plan.waypoints, finger, "waypoints")?,
         None => Vec::new(),
     };
     let candidates = match plan {
@@ -352,7 +469,7 @@ fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Res
                 Ok(json!({
                     "guide": c.guide,
                     "collision_free": c.collision_free,
-                    "tcp": tcp_path(&c.waypoints, finger, &format!("candidates[{i}].waypoints"))?,
+                    "tcp": tcp_path(robot, &c.waypoints, finger, &format!("candidates[{i}].waypoints"))?,
                 }))
             })
             .collect::<Result<Vec<_>, String>>()?,
@@ -370,10 +487,11 @@ fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Res
     };
     Ok(json!({
         "title": title,
-        "frames": FRAME_NAMES,
-        "tcp_frame": TCP_FRAME,
-        "hand_frame": HAND_FRAME,
-        "meshes": robot_meshes()?,
+        "robot": robot.name,
+        "frames": robot.frame_names,
+        "tcp_frame": robot.tcp_frame,
+        "hand_frame": robot.hand_frame,
+        "meshes": robot_meshes(robot.name, robot.frame_names)?,
         "obstacles": problem.scene().obstacles().iter().map(primitive).collect::<Vec<_>>(),
         "surfaces": surfaces(&problem.surfaces.obstacles),
         "held": problem.scene().held().map(primitive),
@@ -386,28 +504,40 @@ fn page_data(problem: &Problem, plan: Option<&PlanDocument>, title: &str) -> Res
     }))
 }
 
-/// Every `<visual>` mesh of the URDF: the link frame it moves with, its origin in that frame,
-/// and its triangles (little-endian `f32` vertices and `u32` indices, base64) in colour groups.
-pub fn robot_meshes() -> Result<Vec<Value>, String> {
-    let robot = urdf_rs::read_from_string(URDF).map_err(|e| format!("panda.urdf: {e}"))?;
+/// Every `<visual>` mesh of the arm's URDF (the xArm's: every `<collision>` mesh): the link
+/// frame it moves with (an index into `frames`), its origin in that frame, and its triangles
+/// (little-endian `f32` vertices and `u32` indices, base64) in colour groups.
+pub fn robot_meshes(arm: &str, frames: &[&str]) -> Result<Vec<Value>, String> {
+    let v = VISUALS
+        .iter()
+        .find(|v| v.arm == arm)
+        .ok_or_else(|| format!("{arm}: the viewer has no meshes for this arm"))?;
+    let name = v.file;
+    let robot = urdf_rs::read_from_string(v.urdf).map_err(|e| format!("{name}: {e}"))?;
     let mut out = Vec::new();
     for link in &robot.links {
-        for visual in &link.visual {
-            let urdf_rs::Geometry::Mesh { filename, scale } = &visual.geometry else {
-                return Err(format!("panda.urdf: {}: only mesh visuals are drawn", link.name));
+        let drawn: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)> = if v.collision {
+            link.collision.iter().map(|c| (&c.geometry, &c.origin)).collect()
+        } else {
+            link.visual.iter().map(|c| (&c.geometry, &c.origin)).collect()
+        };
+        for (geometry, origin) in drawn {
+            let urdf_rs::Geometry::Mesh { filename, scale } = geometry else {
+                return Err(format!("{name}: {}: only mesh visuals are drawn", link.name));
             };
-            let frame = FRAME_NAMES
+            let frame = frames
                 .iter()
                 .position(|&n| n == link.name)
-                .ok_or_else(|| format!("panda.urdf: link {} has a visual but no frame", link.name))?;
+                .ok_or_else(|| format!("{name}: link {} has a visual but no frame", link.name))?;
             let file = filename.trim_start_matches("package://");
-            let (_, obj, mtl) = MESH_FILES
+            let (_, obj, mtl) = v
+                .files
                 .iter()
                 .find(|(path, _, _)| *path == file)
-                .ok_or_else(|| format!("panda.urdf: {}: mesh {file} is not embedded", link.name))?;
+                .ok_or_else(|| format!("{name}: {}: mesh {file} is not embedded", link.name))?;
             let mesh = parse_obj(obj, &parse_mtl(mtl)).map_err(|e| format!("{file}: {e}"))?;
-            let [x, y, z] = *visual.origin.xyz;
-            let [roll, pitch, yaw] = *visual.origin.rpy;
+            let [x, y, z] = *origin.xyz;
+            let [roll, pitch, yaw] = *origin.rpy;
             // URDF rpy: fixed axes x, y, z, i.e. Rz(yaw)·Ry(pitch)·Rx(roll).
             let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_euler_angles(roll, pitch, yaw));
             out.push(json!({
@@ -557,6 +687,8 @@ fn base64(bytes: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use edmp_core::robot::kinematics::Joints;
+    use edmp_core::robot::{FRAMES, TCP_FRAME};
 
     #[test]
     fn base64_matches_the_rfc_examples() {
@@ -592,13 +724,54 @@ mod tests {
 
     #[test]
     fn every_visual_of_the_urdf_is_embedded_and_on_a_frame() {
-        let meshes = robot_meshes().unwrap();
+        let meshes = robot_meshes("panda", edmp_core::robot::PANDA.frame_names).unwrap();
         // link0..link7, hand, two fingers: every link with a mesh.
         assert_eq!(meshes.len(), 11);
         let right = meshes.iter().find(|m| m["link"] == "panda_rightfinger").unwrap();
         // The right finger's visual is turned half a turn about z (its URDF origin).
         let q = right["quaternion"].as_array().unwrap();
         assert!(q[0].as_f64().unwrap().abs() < 1e-9 && (q[3].as_f64().unwrap().abs() - 1.0).abs() < 1e-9);
+    }
+
+    /// Another arm's scene and plan: its own meshes on its own frames, its FK in the samples.
+    fn another_arms_page<const J: usize>(robot: &'static Robot<f32, J>, meshes: usize) {
+        let path = format!(
+            "{}/../benchmarks/{}/problems/cubby/000.json",
+            env!("CARGO_MANIFEST_DIR"),
+            robot.name
+        );
+        let text = std::fs::read_to_string(&path).unwrap();
+        let problem = parse_problem_for(&text, Path::new("."), robot).unwrap();
+        let plan = PlanDocument {
+            waypoints: vec![problem.start; 3],
+            ..parse_plan_for::<J>(&plan_text(robot)).unwrap()
+        };
+        let data = embedded_data(&page(&problem, Some(&plan), "arm").unwrap());
+        assert_eq!(data["robot"], robot.name);
+        assert_eq!(data["frames"].as_array().unwrap().len(), robot.frame_names.len());
+        let list = data["meshes"].as_array().unwrap();
+        assert_eq!(list.len(), meshes, "{}", robot.name);
+        for m in list {
+            let frame = m["frame"].as_u64().unwrap() as usize;
+            assert_eq!(m["link"], robot.frame_names[frame]);
+            assert!(!m["indices"].as_str().unwrap().is_empty());
+        }
+        let poses = data["samples"]["poses"].as_array().unwrap();
+        assert_eq!(poses.len(), 3);
+        assert_eq!(poses[0].as_array().unwrap().len(), robot.frame_names.len() * 7);
+    }
+
+    /// The smallest `edmp-plan/1` document of `robot`'s joint count.
+    fn plan_text<const J: usize>(robot: &Robot<f32, J>) -> String {
+        let q = vec![0.0f32; robot.joint_names.len()];
+        serde_json::json!({"format": "edmp-plan/1", "status": "success", "waypoints": vec![q; 50]}).to_string()
+    }
+
+    #[test]
+    fn another_arm_is_drawn_with_its_own_meshes() {
+        // The iiwa's eight visual meshes; the xArm's seven collision meshes (base and links).
+        another_arms_page(&edmp_core::robot::arms::iiwa7::ROBOT, 8);
+        another_arms_page(&edmp_core::robot::arms::xarm6::ROBOT, 7);
     }
 
     fn embedded_data(html: &str) -> Value {
@@ -676,7 +849,7 @@ mod tests {
     fn the_page_holds_the_clouds_points_and_the_meshes_triangles() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/surfaces.json");
         let dir = Path::new(path).parent().unwrap();
-        let problem = parse_problem_in(&std::fs::read_to_string(path).unwrap(), dir).unwrap();
+        let problem = crate::formats::json::parse_problem_in(&std::fs::read_to_string(path).unwrap(), dir).unwrap();
         let data = embedded_data(&page(&problem, None, "surfaces").unwrap());
         assert_eq!(data["obstacles"].as_array().unwrap().len(), 1, "the sphere");
         let floats = |v: &Value| -> Vec<f32> {
