@@ -16,32 +16,36 @@
 //! [`covers`]. Every refusal is a [`WireError`], never a panic.
 
 use crate::cost::cover::{MAX_COVERS, covers};
-use crate::robot::kinematics::Joints;
+use crate::robot::JOINTS;
 use crate::scene::{MAX_OBSTACLES, Obstacle, Primitive, Scene, SceneError};
 use crate::surface::Surface;
 use crate::surface::bvh::Node;
 use crate::surface::element::{Element, Piece, SurfaceError};
 use serde::{Deserialize, Serialize};
 /// One planning problem: obstacles (at most `N`), the held object, the finger opening, the
-/// ends and the seed.
+/// ends (`J` joints: the arm the firmware was built for; the bytes do not name it) and the seed.
+/// A joint vector is `J` plain `f32`s on the wire, so the Panda's bytes are what they were
+/// before the arm became a parameter.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Problem<const N: usize = MAX_OBSTACLES> {
+#[serde(bound(serialize = "[f32; J]: Serialize", deserialize = "[f32; J]: Deserialize<'de>"))]
+pub struct Problem<const N: usize = MAX_OBSTACLES, const J: usize = JOINTS> {
     /// The obstacles, in the scene file's order (the checker reports contacts by index).
     pub obstacles: heapless::Vec<Primitive, N>,
-    /// An object held in the hand (pose in the `panda_hand` frame), if any.
+    /// An object held in the hand (pose in the `panda_hand` frame; another arm's TCP link), if
+    /// any.
     pub held: Option<Primitive>,
     /// Opening of each finger, metres (the scene file's `gripper.finger`; 0.025 when absent),
     /// validated by [`Scene::set_gripper`].
     pub finger: f32,
     /// Start configuration.
-    pub start: Joints<f32>,
+    pub start: [f32; J],
     /// Goal configuration.
-    pub goal: Joints<f32>,
+    pub goal: [f32; J],
     /// Seed of the planner's [`crate::rng::Rng`].
     pub seed: u64,
 }
 
-impl<const N: usize> Problem<N> {
+impl<const N: usize, const J: usize> Problem<N, J> {
     /// The scene, every primitive validated on the way in.
     pub fn to_scene(&self) -> Result<Scene<'static, N>, SceneError> {
         let mut scene = Scene::new();
@@ -245,10 +249,13 @@ impl<const P: usize, const T: usize> WireSurface<P, T> {
 
 /// Decodes a problem (at most `N` obstacles) and, when bytes follow it, its surface section
 /// into `surface` (emptied first), validating each piece and the tree.
-pub fn decode<const N: usize, const P: usize, const T: usize>(
+pub fn decode<const N: usize, const P: usize, const T: usize, const J: usize>(
     bytes: &[u8],
     surface: &mut WireSurface<P, T>,
-) -> Result<Problem<N>, WireError> {
+) -> Result<Problem<N, J>, WireError>
+where
+    [f32; J]: for<'de> Deserialize<'de>,
+{
     let decoded = decode_into(bytes, surface);
     if decoded.is_err() {
         // A refused section leaves no half-filled buffers behind.
@@ -259,14 +266,17 @@ pub fn decode<const N: usize, const P: usize, const T: usize>(
     decoded
 }
 
-fn decode_into<const N: usize, const P: usize, const T: usize>(
+fn decode_into<const N: usize, const P: usize, const T: usize, const J: usize>(
     bytes: &[u8],
     surface: &mut WireSurface<P, T>,
-) -> Result<Problem<N>, WireError> {
+) -> Result<Problem<N, J>, WireError>
+where
+    [f32; J]: for<'de> Deserialize<'de>,
+{
     surface.pieces.clear();
     surface.nodes.clear();
     surface.boxes = 0;
-    let (problem, rest) = take::<Problem<N>>(bytes)?;
+    let (problem, rest) = take::<Problem<N, J>>(bytes)?;
     if rest.is_empty() {
         return Ok(problem);
     }
@@ -428,10 +438,13 @@ mod tests {
         let (pieces, nodes) = cloud(60);
         let mut s = std::boxed::Box::new(WireSurface::<64>::new());
         // Without a section: the bytes of a problem as before surfaces.
-        assert_eq!(decode::<4, 64, 64>(&bytes(&p, &[], &[], 0), &mut s), Ok(p.clone()));
+        assert_eq!(
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &[], &[], 0), &mut s),
+            Ok(p.clone())
+        );
         assert!(s.pieces().is_empty());
         let b = bytes(&p, &pieces, &nodes, 5);
-        assert_eq!(decode::<4, 64, 64>(&b, &mut s), Ok(p.clone()));
+        assert_eq!(decode::<4, 64, 64, JOINTS>(&b, &mut s), Ok(p.clone()));
         assert_eq!((s.pieces(), s.nodes(), s.boxes()), (&pieces[..], &nodes[..], 5));
         let scene = p.to_scene_with(&s).unwrap();
         assert_eq!(scene.obstacles(), p.to_scene().unwrap().obstacles());
@@ -453,7 +466,10 @@ mod tests {
             count: 1,
             left: 0,
         };
-        assert_eq!(decode::<4, 64, 64>(&bytes(&p, &[t], &[root], 1), &mut s), Ok(p.clone()));
+        assert_eq!(
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &[t], &[root], 1), &mut s),
+            Ok(p.clone())
+        );
         assert_eq!(s.pieces(), &[t]);
     }
 
@@ -468,18 +484,30 @@ mod tests {
         let mut outside = nodes.clone();
         outside[l].lo[1] -= 1.0;
         let refused = Err(WireError::Surface(SurfaceError::TooFewNodes));
-        assert_eq!(decode::<4, 64, 64>(&bytes(&p, &pieces, &outside, 5), &mut s), refused);
+        assert_eq!(
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &pieces, &outside, 5), &mut s),
+            refused
+        );
         assert!(s.pieces().is_empty(), "a refused section leaves the buffers empty");
         // A run beyond the pieces, and a leaf whose run misses one of its pieces' boxes.
         let mut run = nodes.clone();
         let leaf = run.iter().position(|n| n.left == 0).unwrap();
         run[leaf].first = 59;
         run[leaf].count = 4;
-        assert_eq!(decode::<4, 64, 64>(&bytes(&p, &pieces, &run, 5), &mut s), refused);
+        assert_eq!(
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &pieces, &run, 5), &mut s),
+            refused
+        );
         let mut cycle = nodes.clone();
         cycle[l].left = l as u32;
-        assert_eq!(decode::<4, 64, 64>(&bytes(&p, &pieces, &cycle, 5), &mut s), refused);
-        assert_eq!(decode::<4, 64, 64>(&bytes(&p, &pieces, &[], 5), &mut s), refused);
+        assert_eq!(
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &pieces, &cycle, 5), &mut s),
+            refused
+        );
+        assert_eq!(
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &pieces, &[], 5), &mut s),
+            refused
+        );
         // Pieces validated as the constructors do.
         let mut bad = pieces.clone();
         bad[3].piece = Piece::Ball {
@@ -487,7 +515,7 @@ mod tests {
             radius: 0.0075,
         };
         assert_eq!(
-            decode::<4, 64, 64>(&bytes(&p, &bad, &nodes, 5), &mut s),
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &bad, &nodes, 5), &mut s),
             Err(WireError::Surface(SurfaceError::NonFinite))
         );
         let flat = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
@@ -495,35 +523,35 @@ mod tests {
             corners: flat.map(Into::into),
         };
         assert_eq!(
-            decode::<4, 64, 64>(&bytes(&p, &bad, &nodes, 5), &mut s),
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &bad, &nodes, 5), &mut s),
             Err(WireError::DegenerateTriangle)
         );
         // Capacity, boxes, truncation, trailing bytes.
         assert_eq!(
-            decode::<4, 32, 32>(&good, &mut std::boxed::Box::new(WireSurface::new())),
+            decode::<4, 32, 32, JOINTS>(&good, &mut std::boxed::Box::new(WireSurface::new())),
             Err(WireError::Capacity)
         );
         // Room for the pieces, not for their tree's nodes.
         assert!(nodes.len() > 1);
         assert_eq!(
-            decode::<4, 64, 1>(&good, &mut std::boxed::Box::new(WireSurface::new())),
+            decode::<4, 64, 1, JOINTS>(&good, &mut std::boxed::Box::new(WireSurface::new())),
             Err(WireError::Capacity)
         );
         assert_eq!(
-            decode::<4, 64, 64>(&bytes(&p, &pieces, &nodes, 65), &mut s),
+            decode::<4, 64, 64, JOINTS>(&bytes(&p, &pieces, &nodes, 65), &mut s),
             Err(WireError::TooManyBoxes)
         );
         for cut in [good.len() - 1, good.len() - 30, 80] {
             assert_eq!(
-                decode::<4, 64, 64>(&good[..cut], &mut s),
+                decode::<4, 64, 64, JOINTS>(&good[..cut], &mut s),
                 Err(WireError::Decode),
                 "{cut}"
             );
         }
         let mut long = good.clone();
         long.push(0);
-        assert_eq!(decode::<4, 64, 64>(&long, &mut s), Err(WireError::Decode));
-        assert_eq!(decode::<4, 64, 64>(&good, &mut s), Ok(p));
+        assert_eq!(decode::<4, 64, 64, JOINTS>(&long, &mut s), Err(WireError::Decode));
+        assert_eq!(decode::<4, 64, 64, JOINTS>(&good, &mut s), Ok(p));
     }
 
     #[test]
@@ -535,7 +563,7 @@ mod tests {
         let mut s = std::boxed::Box::new(WireSurface::<32>::new());
         let mut rng = crate::rng::Rng::new(11);
         for cut in 0..good.len() {
-            let _ = decode::<4, 32, 32>(&good[..cut], &mut s);
+            let _ = decode::<4, 32, 32, JOINTS>(&good[..cut], &mut s);
         }
         for _ in 0..20_000 {
             let mut b = good.clone();
@@ -543,7 +571,7 @@ mod tests {
                 let i = (rng.next_u64() % b.len() as u64) as usize;
                 b[i] = rng.next_u64() as u8;
             }
-            if decode::<4, 32, 32>(&b, &mut s).is_ok_and(|q| q.to_scene_with(&s).is_ok()) {
+            if decode::<4, 32, 32, JOINTS>(&b, &mut s).is_ok_and(|q| q.to_scene_with(&s).is_ok()) {
                 assert!(s.surface().is_ok());
             }
         }

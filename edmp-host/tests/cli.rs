@@ -105,13 +105,18 @@ fn another_arms_scene_is_planned_with_its_joints_or_refused_by_name() {
     let out = edmp_host(&["plan", seven.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("start: expected 6 numbers, found 7"));
-    let out = edmp_host(&["embed", scene, "--out", dir.join("embedded").to_str().unwrap()]);
+    // The firmware's bytes carry the arm's 6 joints; one call embeds one arm's scenes.
+    let embedded = dir.join("embedded");
+    let out = edmp_host(&["embed", scene, "--out", embedded.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(embedded.join("cubby-000.postcard")).unwrap();
+    let mut surface = Box::new(edmp_core::wire::WireSurface::<320, 80>::new());
+    let problem = edmp_core::wire::decode::<64, 320, 80, 6>(&bytes, &mut surface).unwrap();
+    assert_eq!(problem.start.len(), 6);
+    let out = edmp_host(&["embed", scene, "examples/wall.json", "--out", embedded.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        stderr.contains(r#"robot: "xarm6": this command runs the panda only"#),
-        "{stderr}"
-    );
+    assert!(stderr.contains("one firmware plans one arm"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -1,4 +1,4 @@
-//! Arbitrary bytes through the firmware's decoder: `wire::decode::<N, P, P>` (a problem, then an
+//! Arbitrary bytes through the firmware's decoder: `wire::decode::<N, P, P, JOINTS>` (a problem, then an
 //! optional surface section of built pieces and their tree) then `Problem::to_scene_with`, as
 //! examples/firmware-qemu decodes. Decoding must fail with a typed error or give a problem and a
 //! surface whose encoding is stable; a decoded surface's tree is one `Surface::new`
@@ -7,6 +7,7 @@
 //! (then the opening's), never `TooManyObstacles` (the list and the scene share N).
 #![no_main]
 
+use edmp_core::robot::JOINTS;
 use edmp_core::scene::{SceneError, Shape};
 use edmp_core::wire::{Problem, WireError, WireSurface, decode, encode_surface, surface_bytes_max};
 use libfuzzer_sys::fuzz_target;
@@ -17,7 +18,7 @@ const P: usize = 64;
 
 fuzz_target!(|data: &[u8]| {
     let mut surface = Box::new(WireSurface::<P>::new());
-    let Ok(problem) = decode::<N, P, P>(data, &mut surface) else {
+    let Ok(problem) = decode::<N, P, P, JOINTS>(data, &mut surface) else {
         assert!(surface.pieces().is_empty() && surface.nodes().is_empty(), "a refused input leaves no pieces");
         return;
     };
@@ -27,7 +28,7 @@ fuzz_target!(|data: &[u8]| {
     // What it re-encodes to decodes to the same problem and surface, and re-encodes alike.
     let bytes = encode(&problem, &surface);
     let mut again = Box::new(WireSurface::<P>::new());
-    let back = decode::<N, P, P>(&bytes, &mut again).expect("re-encoded bytes decode");
+    let back = decode::<N, P, P, JOINTS>(&bytes, &mut again).expect("re-encoded bytes decode");
     assert_eq!(encode(&back, &again), bytes, "encoding is not stable");
     assert_eq!(again.pieces().len(), surface.pieces().len());
 

@@ -8,17 +8,20 @@
 //! A scene with `points` or `mesh` obstacles travels with its pieces and tree as the host built
 //! them (`edmp_core::wire`), at most [`FIRMWARE_PIECES`] of them.
 //! `DIR/expected-timed.txt` has `<name> <fingerprint|none>`: the chosen path's time
-//! parameterization (Franka's limits, jerk-limited) for free plans, as the firmware times it.
+//! parameterization (the arm's limits, jerk-limited) for free plans, as the firmware times it.
+//! Every scene names its arm (`robot`): the bytes carry its joints, and the firmware built for
+//! that arm (`scripts/firmware --robot NAME`) plans them. One call embeds one arm's scenes.
 
-use crate::Failure;
-use crate::formats::json::{self, joint_goal, parse_problem, read_problem};
+use crate::arm::Arm;
+use crate::formats::json::{self, joint_goal, parse_problem, parse_problem_for, scene_arm};
 use crate::formats::surface::SURFACE_BOXES;
+use crate::{Failure, with_arm};
 use core::fmt::Write as _;
 use edmp_core::guidance::guides::EDMP_GUIDES;
 use edmp_core::planner::{Plan, PlanConfig, Request, Workspace, plan};
-use edmp_core::prior::Scratch;
+use edmp_core::prior::{Network, Scratch};
 use edmp_core::rng::Rng;
-use edmp_core::robot::{JOINTS, PANDA};
+use edmp_core::robot::Robot;
 use edmp_core::scene::{MAX_OBSTACLES, Scene};
 use edmp_core::surface::bvh::nodes_for;
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
@@ -66,9 +69,9 @@ pub const FIRMWARE_OBSTACLES: usize = 40;
 
 /// A scene as the firmware receives it.
 #[derive(Clone, Debug)]
-pub struct Embedded {
+pub struct Embedded<const J: usize> {
     /// The primitives, ends, finger opening and seed.
-    pub problem: Problem<MAX_OBSTACLES>,
+    pub problem: Problem<MAX_OBSTACLES, J>,
     /// The postcard bytes: the problem's, then the surface section when the scene has clouds
     /// or meshes (`edmp_core::wire::decode`).
     pub bytes: Vec<u8>,
@@ -92,7 +95,10 @@ pub fn wire_problem(text: &str, seed: u64) -> Result<Problem<MAX_OBSTACLES>, Str
 
 /// The firmware's bytes of a parsed scene (its clouds and meshes built by `parse_problem`, the
 /// pieces and the tree travelling as built), checked to decode to the host's scene exactly.
-pub fn embed_problem(parsed: &json::Problem, seed: u64) -> Result<Embedded, String> {
+pub fn embed_problem<const J: usize>(parsed: &json::Problem<J>, seed: u64) -> Result<Embedded<J>, String>
+where
+    [f32; J]: serde::Serialize + for<'de> serde::Deserialize<'de>,
+{
     let goal = joint_goal(parsed)?;
     let mut problem = Problem {
         obstacles: Default::default(),
@@ -136,7 +142,7 @@ pub fn embed_problem(parsed: &json::Problem, seed: u64) -> Result<Embedded, Stri
     // The firmware rebuilds the scene from these bytes: it must be the host's scene exactly.
     let mut decoded = Box::new(Decoded::new());
     let back =
-        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(&bytes, &mut decoded).map_err(|e| e.to_string())?;
+        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES, J>(&bytes, &mut decoded).map_err(|e| e.to_string())?;
     let rebuilt = back.to_scene_with(&decoded).map_err(|e| e.to_string())?;
     let scene = parsed.scene();
     if back != problem
@@ -152,20 +158,27 @@ pub fn embed_problem(parsed: &json::Problem, seed: u64) -> Result<Embedded, Stri
     Ok(Embedded { problem, bytes })
 }
 
-/// The firmware's plan of `bytes`, on the host: the scene decoded from them, same
+/// The firmware's plan of `bytes` for `robot`, on the host: the scene decoded from them, same
 /// configuration, guides, rows and seed.
-pub fn plan_like_firmware(bytes: &[u8]) -> Result<Plan<ROWS>, String> {
+pub fn plan_like_firmware<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    network: &'static Network<J>,
+    bytes: &[u8],
+) -> Result<Plan<ROWS, J>, String>
+where
+    [f32; J]: for<'de> serde::Deserialize<'de>,
+{
     let mut decoded = Box::new(Decoded::new());
     let problem =
-        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
+        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES, J>(bytes, &mut decoded).map_err(|e| e.to_string())?;
     let scene: Scene<MAX_OBSTACLES> = problem.to_scene_with(&decoded).map_err(|e| e.to_string())?;
     let mut scratch = Box::new(Scratch::<4>::new());
-    let mut work = Box::new(Workspace::<ROWS>::new());
+    let mut work = Box::new(Workspace::<ROWS, { edmp_core::planner::DEFAULT_SEARCH_NODES }, J>::new());
     let mut rng = Rng::new(problem.seed);
-    plan::<ROWS, MAX_OBSTACLES, 4, { edmp_core::planner::DEFAULT_SEARCH_NODES }, JOINTS>(
+    plan::<ROWS, MAX_OBSTACLES, 4, { edmp_core::planner::DEFAULT_SEARCH_NODES }, J>(
         &Request {
-            robot: &PANDA,
-            network: edmp_core::prior::PANDA,
+            robot,
+            network,
             scene: &scene,
             start: &problem.start,
             goal: &problem.goal,
@@ -182,23 +195,54 @@ pub fn plan_like_firmware(bytes: &[u8]) -> Result<Plan<ROWS>, String> {
 /// Writes the bytes and the expected results.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let input = |e: String| Failure::Input(e);
+    let mut texts = Vec::new();
+    let mut arms: Vec<Arm> = Vec::new();
+    for path in &args.scenes {
+        let text = std::fs::read_to_string(path).map_err(|e| input(format!("{}: {e}", path.display())))?;
+        let arm = scene_arm(&text).map_err(|e| input(format!("{}: {e}", path.display())))?;
+        if arms.first().is_some_and(|first| *first != arm) {
+            return Err(input(format!(
+                "{}: robot {arm}, but {} is {}: one firmware plans one arm (embed each arm's scenes apart)",
+                path.display(),
+                args.scenes[0].display(),
+                arms[0]
+            )));
+        }
+        arms.push(arm);
+        texts.push(text);
+    }
+    let arm = arms.first().copied().unwrap_or_default();
+    with_arm!(arm, robot, network => write_all(args, &texts, robot, network)).map_err(input)?
+}
+
+fn write_all<const J: usize>(
+    args: &Args,
+    texts: &[String],
+    robot: &'static Robot<f32, J>,
+    network: &'static Network<J>,
+) -> Result<(), Failure>
+where
+    [f32; J]: serde::Serialize + for<'de> serde::Deserialize<'de>,
+{
+    let input = |e: String| Failure::Input(e);
     std::fs::create_dir_all(&args.out).map_err(|e| input(format!("{}: {e}", args.out.display())))?;
     let mut expected = String::new();
     let mut expected_timed = String::new();
-    for path in &args.scenes {
+    for (path, text) in args.scenes.iter().zip(texts) {
         let at = |e: String| Failure::Input(format!("{}: {e}", path.display()));
         let name = scene_name(path).map_err(input)?;
         // Files a scene names (clouds, meshes) lie beside it.
-        let parsed = read_problem(path).map_err(input)?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let parsed = parse_problem_for(text, dir, robot).map_err(|e| at(e.to_string()))?;
         let Embedded { bytes, .. } = embed_problem(&parsed, args.seed).map_err(at)?;
         let file = args.out.join(format!("{name}.postcard"));
         std::fs::write(&file, &bytes).map_err(|e| input(format!("{}: {e}", file.display())))?;
-        let plan = plan_like_firmware(&bytes).map_err(at)?;
+        let plan = plan_like_firmware(robot, network, &bytes).map_err(at)?;
         let status = if plan.is_free() { "success" } else { "collision" };
         let line = format!("{name} {status} {:016x}", plan.fingerprint());
         println!("{line}  ({} bytes)", bytes.len());
         let _ = writeln!(expected, "{line}");
-        let timed = time_like_firmware(&bytes, &plan).map_err(at)?;
+        let timed = time_like_firmware(robot, &bytes, &plan).map_err(at)?;
         let _ = writeln!(
             expected_timed,
             "{name} {}",
@@ -214,17 +258,25 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 
 /// The firmware's time parameterization of a free plan's chosen path, on the host: its
 /// fingerprint, `None` for a colliding plan (the firmware times only free ones).
-pub fn time_like_firmware(bytes: &[u8], plan: &Plan<ROWS>) -> Result<Option<u64>, String> {
+pub fn time_like_firmware<const J: usize>(
+    robot: &'static Robot<f32, J>,
+    bytes: &[u8],
+    plan: &Plan<ROWS, J>,
+) -> Result<Option<u64>, String>
+where
+    [f32; J]: for<'de> serde::Deserialize<'de>,
+{
     let Some(path) = plan.paths.get(plan.best).filter(|_| plan.is_free()) else {
         return Ok(None);
     };
     let mut decoded = Box::new(Decoded::new());
     let problem =
-        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(bytes, &mut decoded).map_err(|e| e.to_string())?;
+        decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES, J>(bytes, &mut decoded).map_err(|e| e.to_string())?;
     let scene: Scene<MAX_OBSTACLES> = problem.to_scene_with(&decoded).map_err(|e| e.to_string())?;
-    let mut timed: Box<Timed> = Box::new(Timed::new());
+    let mut timed: Box<Timed<{ edmp_core::trajectory::DEFAULT_GRID }, { edmp_core::path::HORIZON }, J>> =
+        Box::new(Timed::new());
     parameterize_checked(
-        &PANDA,
+        robot,
         &scene,
         path,
         &Limits::DEFAULT,
@@ -238,6 +290,8 @@ pub fn time_like_firmware(bytes: &[u8], plan: &Plan<ROWS>) -> Result<Option<u64>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::formats::json::read_problem;
+    use edmp_core::robot::JOINTS;
 
     #[test]
     fn wall_round_trips_through_postcard() {
@@ -258,7 +312,8 @@ mod tests {
             let e = embed_problem(&parsed, 0).unwrap();
             assert_eq!(e.problem.obstacles.len(), 3, "{file}");
             let mut decoded = Box::new(Decoded::new());
-            let back = decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES>(&e.bytes, &mut decoded).unwrap();
+            let back =
+                decode::<MAX_OBSTACLES, FIRMWARE_PIECES, FIRMWARE_NODES, JOINTS>(&e.bytes, &mut decoded).unwrap();
             assert_eq!(back, e.problem);
             assert_eq!(decoded.pieces().len(), pieces, "{file}");
             let scene = back.to_scene_with(&decoded).unwrap();

@@ -41,8 +41,8 @@ pub struct Args {
         default_value = "ancestral,strided:50,strided:25,strided:10,strided:5,ddim:25,ddim:10"
     )]
     samplers: Vec<String>,
-    /// Training data (`gen-data` .npy) to measure the same metrics on (its last 1,200 trajectories,
-    /// which the trainer holds out).
+    /// Training data (`gen-data` .npy, or a folder of its shards) to measure the same metrics on
+    /// (its last 1,200 trajectories, which the trainer holds out).
     #[arg(long)]
     data: Option<PathBuf>,
     /// Draw the samples of the problem with the longest start-to-goal distance (first and last
@@ -140,7 +140,33 @@ fn row(label: &str, q: &[Quality], ms: Option<(f64, f64)>) -> String {
     )
 }
 
+/// A `gen-data` `.npy`, or a folder of its shards (`weights/prior/shards.py`: `shard-*.npy`,
+/// concatenated in name order, as `train.py` reads them).
 fn read_npy<const J: usize>(path: &std::path::Path) -> Result<Vec<Path<J>>, String> {
+    if !path.is_dir() {
+        return read_npy_file(path);
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(path)
+        .map_err(|e| format!("{}: {e}", path.display()))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("shard-") && n.ends_with(".npy"))
+        })
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(format!("{}: no shard-*.npy in this folder", path.display()));
+    }
+    let mut all = Vec::new();
+    for file in &files {
+        all.extend(read_npy_file::<J>(file)?);
+    }
+    Ok(all)
+}
+
+fn read_npy_file<const J: usize>(path: &std::path::Path) -> Result<Vec<Path<J>>, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let bad = || {
         format!(

@@ -11,8 +11,9 @@
 //! ```
 //!
 //! The `timed` line is the chosen path's time parameterization (`edmp_core::trajectory`, the
-//! spline checked against the scene, Franka's limits, jerk-limited), for free plans (`none`
-//! otherwise). `scripts/firmware` compares name, status and fingerprints with the host's plan
+//! spline checked against the scene, the arm's limits, jerk-limited), for free plans (`none`
+//! otherwise). The arm is a build-time choice: the Panda by default, the KUKA iiwa 7 with the
+//! cargo feature `iiwa7` (its own scenes, `scenes/iiwa7/`; `scripts/firmware --robot iiwa7`). `scripts/firmware` compares name, status and fingerprints with the host's plan
 //! and trajectory of the same bytes. Instructions come from SysTick under `-icount shift=0` (calibrated at start against a
 //! loop of known length); stack is the high-water mark of a painted stack. Printing uses no
 //! `core::fmt`, so that the `panic-check` build links only what the planner needs.
@@ -28,11 +29,10 @@ use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
 use cortex_m_semihosting::hio::{self, HostStream};
 use edmp_core::Error;
 use edmp_core::guidance::guides::EDMP_GUIDES;
-use edmp_core::planner::{Request, Plan, PlanConfig, Workspace, plan};
-use edmp_core::prior::{STEPS, Scratch, TimeEmbedding, initial_noise, predict_noise};
-use edmp_core::path::{HORIZON, Path};
+use edmp_core::path::HORIZON;
+use edmp_core::planner::{Plan, PlanConfig, Request, Workspace, plan};
+use edmp_core::prior::{STEPS, Scratch, initial_noise};
 use edmp_core::rng::Rng;
-use edmp_core::robot::{JOINTS, PANDA};
 use edmp_core::scene::{Scene, SceneError};
 use edmp_core::surface::bvh::nodes_for;
 use edmp_core::trajectory::{Limits, Timed, parameterize_checked};
@@ -69,28 +69,71 @@ const PIECES: usize = 320;
 /// Tree nodes: as many as any tree over `PIECES` pieces has. 36 bytes each, in `.bss`.
 const NODES: usize = nodes_for(PIECES);
 
-/// The embedded scenes, in `edmp-host embed`'s order (scripts/firmware lists the same files).
-const SCENES: &[(&str, &[u8])] = &[
-    ("examples-wall", include_bytes!("../scenes/examples-wall.postcard")),
-    (
-        "examples-tabletop-pose-held",
-        include_bytes!("../scenes/examples-tabletop-pose-held.postcard"),
-    ),
-    ("cubby-000", include_bytes!("../scenes/cubby-000.postcard")),
-    ("dresser-000", include_bytes!("../scenes/dresser-000.postcard")),
-    // An unseen kind whose first stage collides: the global stage (search, reseeding) runs.
-    ("window_box-003", include_bytes!("../scenes/window_box-003.postcard")),
-    // The wall's vertical box as a cloud of 280 points, then as a mesh of 12 triangles.
-    ("examples-wall-points", include_bytes!("../scenes/examples-wall-points.postcard")),
-    ("examples-wall-mesh", include_bytes!("../scenes/examples-wall-mesh.postcard")),
-];
+/// The Panda: its tables, its prior and its scenes.
+#[cfg(not(feature = "iiwa7"))]
+mod arm {
+    use edmp_core::prior::Network;
+    pub use edmp_core::robot::arms::panda::{JOINTS, ROBOT};
+
+    /// The arm's trained prior.
+    pub const NETWORK: &Network<JOINTS> = edmp_core::prior::PANDA;
+
+    /// The embedded scenes, in `edmp-host embed`'s order (scripts/firmware lists the same files).
+    pub const SCENES: &[(&str, &[u8])] = &[
+        ("examples-wall", include_bytes!("../scenes/examples-wall.postcard")),
+        (
+            "examples-tabletop-pose-held",
+            include_bytes!("../scenes/examples-tabletop-pose-held.postcard"),
+        ),
+        ("cubby-000", include_bytes!("../scenes/cubby-000.postcard")),
+        ("dresser-000", include_bytes!("../scenes/dresser-000.postcard")),
+        // An unseen kind whose first stage collides: the global stage (search, reseeding) runs.
+        ("window_box-003", include_bytes!("../scenes/window_box-003.postcard")),
+        // The wall's vertical box as a cloud of 280 points, then as a mesh of 12 triangles.
+        (
+            "examples-wall-points",
+            include_bytes!("../scenes/examples-wall-points.postcard"),
+        ),
+        (
+            "examples-wall-mesh",
+            include_bytes!("../scenes/examples-wall-mesh.postcard"),
+        ),
+    ];
+}
+
+/// The KUKA LBR iiwa 7: its tables, its prior and its scenes (from its own suites).
+#[cfg(feature = "iiwa7")]
+mod arm {
+    use edmp_core::prior::Network;
+    pub use edmp_core::robot::arms::iiwa7::{JOINTS, ROBOT};
+
+    /// The arm's trained prior (the build stops here if it has none).
+    pub const NETWORK: &Network<JOINTS> = match edmp_core::prior::arms::iiwa7::NETWORK {
+        Some(network) => network,
+        None => panic!("the iiwa 7 has no trained prior (weights/README.md, \"Another arm\")"),
+    };
+
+    /// The embedded scenes, in `edmp-host embed`'s order (scripts/firmware lists the same files).
+    pub const SCENES: &[(&str, &[u8])] = &[
+        ("tabletop-000", include_bytes!("../scenes/iiwa7/tabletop-000.postcard")),
+        ("cubby-000", include_bytes!("../scenes/iiwa7/cubby-000.postcard")),
+        ("dresser-000", include_bytes!("../scenes/iiwa7/dresser-000.postcard")),
+        // An unseen kind: the global stage (search, reseeding) runs.
+        ("cage-000", include_bytes!("../scenes/iiwa7/cage-000.postcard")),
+    ];
+}
+
+use arm::{JOINTS, NETWORK, ROBOT, SCENES};
+
+/// A path of the arm's joints.
+type Path = edmp_core::path::Path<JOINTS>;
 
 /// The network's working memory for one trajectory at a time (`.bss`, not the stack).
 static mut SCRATCH: Scratch<1> = Scratch::new();
 /// The planner's gradients and noise predictions for the 12 rows (`.bss`).
-static mut WORK: Workspace<ROWS> = Workspace::new();
+static mut WORK: Workspace<ROWS, { edmp_core::planner::DEFAULT_SEARCH_NODES }, JOINTS> = Workspace::new();
 /// The chosen path's time parameterization (`.bss`).
-static mut TIMED: Timed = Timed::new();
+static mut TIMED: Timed<{ edmp_core::trajectory::DEFAULT_GRID }, HORIZON, JOINTS> = Timed::new();
 /// The decoded pieces and tree of the scene's clouds and meshes (`.bss`).
 static mut SURFACE: WireSurface<PIECES, NODES> = WireSurface::new();
 
@@ -285,8 +328,8 @@ struct Summary {
 fn decode<'a>(
     bytes: &[u8],
     surface: &'a mut WireSurface<PIECES, NODES>,
-) -> Result<(Problem<OBSTACLES>, Scene<'a, OBSTACLES>), Failure> {
-    let problem: Problem<OBSTACLES> = decode_wire(bytes, surface).map_err(Failure::Wire)?;
+) -> Result<(Problem<OBSTACLES, JOINTS>, Scene<'a, OBSTACLES>), Failure> {
+    let problem: Problem<OBSTACLES, JOINTS> = decode_wire(bytes, surface).map_err(Failure::Wire)?;
     let surface: &'a WireSurface<PIECES, NODES> = surface;
     let scene = problem.to_scene_with(surface).map_err(Failure::Wire)?;
     Ok((problem, scene))
@@ -298,12 +341,25 @@ fn decode<'a>(
 fn plan_scene(
     bytes: &[u8],
     scratch: &mut Scratch<1>,
-    work: &mut Workspace<ROWS>,
+    work: &mut Workspace<ROWS, { edmp_core::planner::DEFAULT_SEARCH_NODES }, JOINTS>,
     surface: &mut WireSurface<PIECES, NODES>,
 ) -> Result<Summary, Failure> {
     let (problem, scene) = decode(bytes, surface)?;
     let mut rng = Rng::new(problem.seed);
-    let plan: Plan<ROWS> = plan::<ROWS, OBSTACLES, 1, { edmp_core::planner::DEFAULT_SEARCH_NODES }, JOINTS>(&Request { robot: &PANDA, network: edmp_core::prior::PANDA, scene: &scene, start: &problem.start, goal: &problem.goal, guides: &EDMP_GUIDES, config: &PlanConfig::DEFAULT }, &mut rng, scratch, work)
+    let plan: Plan<ROWS, JOINTS> = plan::<ROWS, OBSTACLES, 1, { edmp_core::planner::DEFAULT_SEARCH_NODES }, JOINTS>(
+        &Request {
+            robot: &ROBOT,
+            network: NETWORK,
+            scene: &scene,
+            start: &problem.start,
+            goal: &problem.goal,
+            guides: &EDMP_GUIDES,
+            config: &PlanConfig::DEFAULT,
+        },
+        &mut rng,
+        scratch,
+        work,
+    )
     .map_err(Failure::Plan)?;
     let path = plan.paths.get(plan.best).copied().unwrap_or([[0.0; JOINTS]; HORIZON]);
     Ok(Summary {
@@ -314,18 +370,35 @@ fn plan_scene(
 }
 
 /// Times a free plan's path as the host's `--timed` does: the spline checked against the scene
-/// (else the polyline), Franka's limits, jerk-limited.
+/// (else the polyline), the arm's limits, jerk-limited.
 #[inline(never)]
-fn time_path(bytes: &[u8], path: &Path, timed: &mut Timed, surface: &mut WireSurface<PIECES, NODES>) -> Result<u64, Failure> {
+fn time_path(
+    bytes: &[u8],
+    path: &Path,
+    timed: &mut Timed<{ edmp_core::trajectory::DEFAULT_GRID }, HORIZON, JOINTS>,
+    surface: &mut WireSurface<PIECES, NODES>,
+) -> Result<u64, Failure> {
     let (_, scene) = decode(bytes, surface)?;
-    parameterize_checked(&PANDA, &scene, path, &Limits::DEFAULT, &PlanConfig::DEFAULT.check, timed).map_err(Failure::Plan)?;
+    parameterize_checked(
+        &ROBOT,
+        &scene,
+        path,
+        &Limits::DEFAULT,
+        &PlanConfig::DEFAULT.check,
+        timed,
+    )
+    .map_err(Failure::Plan)?;
     Ok(timed.fingerprint())
 }
 
 /// Ticks of one network evaluation of all 12 rows (noise between the scene's ends, step 255),
 /// to split a plan's instructions into network and the rest.
 #[inline(never)]
-fn time_network(bytes: &[u8], scratch: &mut Scratch<1>, surface: &mut WireSurface<PIECES, NODES>) -> Result<u64, Failure> {
+fn time_network(
+    bytes: &[u8],
+    scratch: &mut Scratch<1>,
+    surface: &mut WireSurface<PIECES, NODES>,
+) -> Result<u64, Failure> {
     let (problem, _) = decode(bytes, surface)?;
     let mut rng = Rng::new(problem.seed);
     let mut paths = [[[0.0f32; JOINTS]; HORIZON]; ROWS];
@@ -333,9 +406,11 @@ fn time_network(bytes: &[u8], scratch: &mut Scratch<1>, surface: &mut WireSurfac
     for x in paths.iter_mut() {
         initial_noise(x, &mut rng, &problem.start, &problem.goal);
     }
-    let time = TimeEmbedding::new(STEPS as u16).map_err(Failure::Plan)?;
+    let time = NETWORK.time(STEPS as u16).map_err(Failure::Plan)?;
     let began = ticks();
-    predict_noise(&paths, &time, scratch, &mut eps).map_err(Failure::Plan)?;
+    NETWORK
+        .predict_noise(&paths, &time, scratch, &mut eps)
+        .map_err(Failure::Plan)?;
     Ok(ticks() - began)
 }
 
