@@ -129,7 +129,12 @@ def main() -> None:
     with tqdm(total=len(todo), unit="shard", disable=args.no_progress) as bar:
         while pending:
             ready, pending = ray.wait(pending, num_returns=1)
-            r = ray.get(ready[0])
+            try:
+                r = ray.get(ready[0])
+            except ray.exceptions.RayError as e:
+                # The shards done so far are kept: the next run resumes after them.
+                ray.shutdown()
+                sys.exit(f"a shard failed, {len(pending)} left undone: {e}")
             workers.add(r["worker"])
             data = np.load(io.BytesIO(r.pop("bytes")))
             if data.ndim != 3 or data.shape[1] != HORIZON:

@@ -67,3 +67,13 @@ def test_two_local_workers_write_every_shard_once(tmp_path: Path) -> None:
     # A second run finds every shard there and runs nothing.
     again = subprocess.run(cmd, check=True, capture_output=True, text=True, timeout=120)
     assert "0 shards to run, 4 already" in again.stderr
+
+
+def test_a_failing_shard_stops_the_run_and_names_it(tmp_path: Path) -> None:
+    pytest.importorskip("ray")
+    cmd = [sys.executable, str(HERE / "shards.py"), "--robot", "xarm6", "--environments", "2", "--shard-size", "1",
+           "--workers", "1", "--host", "/bin/false", "--out", str(tmp_path / "out"), "--no-progress"]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert done.returncode != 0
+    assert "a shard failed" in done.stderr and "gen-data exited 1" in done.stderr, done.stderr[-2000:]
+    assert not list((tmp_path / "out").glob("shard-*.npy"))
