@@ -113,7 +113,13 @@ fn another_arms_scene_is_planned_with_its_joints_or_refused_by_name() {
     let mut surface = Box::new(edmp_core::wire::WireSurface::<320, 80>::new());
     let problem = edmp_core::wire::decode::<64, 320, 80, 6>(&bytes, &mut surface).unwrap();
     assert_eq!(problem.start.len(), 6);
-    let out = edmp_host(&["embed", scene, "examples/wall.json", "--out", embedded.to_str().unwrap()]);
+    let out = edmp_host(&[
+        "embed",
+        scene,
+        "examples/wall.json",
+        "--out",
+        embedded.to_str().unwrap(),
+    ]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("one firmware plans one arm"), "{stderr}");
