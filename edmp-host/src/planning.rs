@@ -8,7 +8,8 @@ use crate::formats::json::{Problem, joint_goal};
 use crate::threads::Threads;
 use edmp_core::executor::{Executor, Serial};
 use edmp_core::guidance::guides::{EDMP_GUIDES, Guide};
-use edmp_core::planner::{Observer, Phase, Plan, PlanConfig, Request, Workspace, plan_observed};
+use edmp_core::planner::search::SearchConfig;
+use edmp_core::planner::{GlobalConfig, Observer, Phase, Plan, PlanConfig, Request, Workspace, plan_observed};
 use edmp_core::prior::{Network, Scratch};
 use edmp_core::rng::Rng;
 use edmp_core::robot::JOINTS;
@@ -18,8 +19,28 @@ use std::time::Instant;
 pub const ROWS: usize = 12;
 
 /// Nodes per search tree the host's workspace holds (the core's default search takes all of
-/// them, `--search-nodes` fewer; the firmware and `edmp-host embed` hold 512).
-pub const HOST_SEARCH_NODES: usize = 4096;
+/// them, `--search-nodes` fewer; the firmware and `edmp-host embed` hold 512). About 1 MB: a
+/// host has the memory, and the iiwa 7's unseen problems need trees this large
+/// (docs/robots.md).
+pub const HOST_SEARCH_NODES: usize = 16384;
+
+/// Sampling iterations of one search on the host. The core's default (8,000) bounds the
+/// firmware's work; trees of [`HOST_SEARCH_NODES`] need more iterations to fill.
+pub const HOST_SEARCH_ITERATIONS: u32 = 32_000;
+
+/// The configuration the host plans with (`plan`, `bench`, the Python package): the core's
+/// [`PlanConfig::DEFAULT`] with [`HOST_SEARCH_ITERATIONS`]. `edmp-host embed` plans as the
+/// firmware does, with the core's default.
+pub const HOST_CONFIG: PlanConfig = PlanConfig {
+    global: Some(GlobalConfig {
+        search: SearchConfig {
+            max_iterations: HOST_SEARCH_ITERATIONS,
+            ..SearchConfig::DEFAULT
+        },
+        ..GlobalConfig::DEFAULT
+    }),
+    ..PlanConfig::DEFAULT
+};
 
 /// A planned problem for an arm of `J` joints and where the time went.
 #[derive(Debug)]

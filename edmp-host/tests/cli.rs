@@ -20,6 +20,28 @@ fn fk_prints_every_frame() {
     assert_eq!(v["within_soft_limits"], true);
 }
 
+/// A reader that has closed its end (`edmp-host fk | head -1` once `head` is done): the output
+/// ends quietly with success, not with a panic.
+#[test]
+fn fk_into_a_closed_pipe_is_no_panic() {
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    for json in [false, true] {
+        let mut args = vec!["fk", "0", "-0.785", "0", "-2.356", "0", "1.571", "0.785"];
+        if json {
+            args.push("--json");
+        }
+        let out = Command::new(env!("CARGO_BIN_EXE_edmp-host"))
+            .args(&args)
+            .stdout(writer.try_clone().expect("a second writer"))
+            .output()
+            .expect("edmp-host runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "json {json}: {:?} {stderr}", out.status);
+        assert!(stderr.is_empty(), "json {json}: {stderr}");
+    }
+}
+
 #[test]
 fn rrt_plans_the_example_and_writes_the_file() {
     let path = std::env::temp_dir().join(format!("edmp-rrt-{}.json", std::process::id()));

@@ -16,7 +16,7 @@ use edmp_host::arm::Arm;
 use edmp_host::formats::json::{Goal, Problem, describe, joint_goal, parse_problem, parse_problem_for, scene_arm};
 use edmp_host::formats::plan::{add_trajectory, parse_plan_for, plan_document};
 use edmp_host::formats::trajectory::TimedRequest;
-use edmp_host::planning::{chosen_guides, plan_problem};
+use edmp_host::planning::{HOST_CONFIG, chosen_guides, plan_problem};
 use edmp_host::with_arm;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -139,7 +139,7 @@ fn plan_for<const J: usize>(
             // its verdict.
             judging: if candidates { Judging::Every } else { Judging::Winner },
             waves: if candidates { 1 } else { PlanConfig::DEFAULT.waves },
-            ..PlanConfig::DEFAULT
+            ..HOST_CONFIG
         };
         let planned = plan_problem(network, &problem, &guides, &config, seed)?;
         let total_ms = began.elapsed().as_secs_f64() * 1e3;
@@ -163,7 +163,7 @@ fn plan_problem_ms(py: Python<'_>, scene: &str, seed: u64, repeats: u32) -> PyRe
         (0..repeats)
             .map(|_| {
                 let began = Instant::now();
-                plan_problem(edmp_core::prior::PANDA, &problem, &guides, &PlanConfig::DEFAULT, seed)?;
+                plan_problem(edmp_core::prior::PANDA, &problem, &guides, &HOST_CONFIG, seed)?;
                 Ok(began.elapsed().as_secs_f64() * 1e3)
             })
             .collect::<Result<Vec<f64>, Failure>>()

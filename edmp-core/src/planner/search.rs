@@ -66,9 +66,10 @@ pub struct SearchConfig {
 
 impl SearchConfig {
     /// The planner's fallback setting: the host's RRT baseline's step, and all of the space's
-    /// capacity (a plan's bits depend on it: the host's CLI holds 4,096 nodes per tree, the
-    /// firmware and `edmp-host embed` 512). 8,000 iterations: on the suites, the problems the
-    /// first stage leaves need up to about 5,300. 25 shortcut attempts (the RRT baseline makes
+    /// capacity (a plan's bits depend on it: the firmware and `edmp-host embed` hold 512 nodes
+    /// per tree). 8,000 iterations: on the Panda's suites, the problems the first stage leaves
+    /// need up to about 5,300 (the host, with 16,384 nodes per tree, allows 32,000 for other
+    /// arms' harder problems). 25 shortcut attempts (the RRT baseline makes
     /// 100): the prior reshapes the path and the winner is shortened again, so more attempts
     /// buy nothing measurable (docs/benchmark.md).
     pub const DEFAULT: Self = Self {

@@ -2,6 +2,8 @@
 //! of any arm the host knows.
 
 use crate::arm::{Arm, with_arm};
+use crate::commands::print_stdout;
+use core::fmt::Write;
 use edmp_core::Error;
 use edmp_core::robot::Robot;
 use edmp_core::robot::kinematics::{Pose, forward};
@@ -70,11 +72,9 @@ pub fn run(args: &Args) -> Result<(), String> {
         .and_then(|q| report(robot, &q).map_err(|e| format!("joints: {e}"))))?;
     if args.json {
         let text = serde_json::to_string_pretty(&report).map_err(|e| format!("cannot write JSON: {e}"))?;
-        println!("{text}");
-        return Ok(());
+        return print_stdout(&format!("{text}\n"));
     }
-    print_table(&report);
-    Ok(())
+    print_stdout(&table(&report))
 }
 
 /// The `--json` document for `robot` at `q` (what `edmp-host fk --json` prints): the one
@@ -135,33 +135,30 @@ fn report<const J: usize>(robot: &'static Robot<f32, J>, q: &[f32; J]) -> Result
     })
 }
 
-fn print_table(r: &Report) {
+fn table(r: &Report) -> String {
     let limits = if r.within_soft_limits { "within" } else { "OUTSIDE" };
-    println!(
-        "{} joints (rad): {:?}  ({limits} the planning limits)",
-        r.robot, r.joints
+    let mut t = format!(
+        "{} joints (rad): {:?}  ({limits} the planning limits)\n{:<20} {:>9} {:>9} {:>9}   {:>8} {:>8} {:>8} {:>8}\n",
+        r.robot, r.joints, "frame", "x", "y", "z", "qw", "qx", "qy", "qz"
     );
-    println!(
-        "{:<20} {:>9} {:>9} {:>9}   {:>8} {:>8} {:>8} {:>8}",
-        "frame", "x", "y", "z", "qw", "qx", "qy", "qz"
-    );
-    let row = |name: &str, p: &PoseOut| {
+    let row = |t: &mut String, name: &str, p: &PoseOut| {
         let [x, y, z] = p.position;
         let [w, i, j, k] = p.quaternion;
-        println!("{name:<20} {x:>9.5} {y:>9.5} {z:>9.5}   {w:>8.5} {i:>8.5} {j:>8.5} {k:>8.5}");
+        let _ = writeln!(
+            t,
+            "{name:<20} {x:>9.5} {y:>9.5} {z:>9.5}   {w:>8.5} {i:>8.5} {j:>8.5} {k:>8.5}"
+        );
     };
     for f in &r.frames {
-        row(f.name, &f.pose);
+        row(&mut t, f.name, &f.pose);
     }
-    println!();
-    println!("collision box centres (half extents in m):");
+    t.push_str("\ncollision box centres (half extents in m):\n");
     for b in &r.collision_boxes {
-        row(b.name, &b.pose);
-        println!(
-            "{:<20} half extents {:.4} {:.4} {:.4}",
-            "", b.half_extents[0], b.half_extents[1], b.half_extents[2]
-        );
+        row(&mut t, b.name, &b.pose);
+        let [x, y, z] = b.half_extents;
+        let _ = writeln!(t, "{:<20} half extents {x:.4} {y:.4} {z:.4}", "");
     }
-    println!();
-    row(&format!("TCP ({})", r.tcp_frame), &r.tcp);
+    t.push('\n');
+    row(&mut t, &format!("TCP ({})", r.tcp_frame), &r.tcp);
+    t
 }

@@ -14,3 +14,15 @@ pub mod render;
 pub mod rrt;
 pub mod sample;
 pub mod view;
+
+/// Writes a command's report to standard output. A reader that stops early (`edmp-host fk |
+/// head -1`) closes the pipe: that ends the output quietly, as for other Unix tools, instead of
+/// the panic `println!` would raise.
+pub(crate) fn print_stdout(text: &str) -> Result<(), String> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(format!("cannot write to standard output: {e}")),
+        _ => Ok(()),
+    }
+}

@@ -7,7 +7,7 @@ use crate::Failure;
 use crate::formats::json::{parse_problem_for, scene_arm};
 use crate::formats::plan::{add_trajectory, plan_document};
 use crate::formats::trajectory::TimedArgs;
-use crate::planning::{chosen_guides, plan_problem_on};
+use crate::planning::{HOST_SEARCH_ITERATIONS, chosen_guides, plan_problem_on};
 use crate::with_arm;
 use edmp_core::cost::boxes::BoxFrame;
 use edmp_core::guidance::guides::{CLEARANCE_GUIDE, Guide, Schedule};
@@ -94,9 +94,9 @@ pub struct Tuning {
     #[arg(long, default_value_t = PlanConfig::DEFAULT.refine_stop.map_or(0, |s| s.stall))]
     refine_stall: u8,
     /// Global stage: sampling iterations of the search before it gives up.
-    #[arg(long, default_value_t = SearchConfig::DEFAULT.max_iterations)]
+    #[arg(long, default_value_t = HOST_SEARCH_ITERATIONS)]
     search_iterations: u32,
-    /// Global stage: nodes per search tree (the host holds at most 4096).
+    /// Global stage: nodes per search tree (the host holds at most 16384).
     #[arg(long, default_value_t = SearchConfig::DEFAULT.max_nodes)]
     search_nodes: u16,
     /// Global stage: random shortcut attempts on the search's raw path before it is resampled
@@ -291,7 +291,7 @@ impl Tuning {
             "no step limit".to_owned()
         };
         let defaults = (
-            SearchConfig::DEFAULT.max_iterations,
+            HOST_SEARCH_ITERATIONS,
             SearchConfig::DEFAULT.max_nodes,
             SearchConfig::DEFAULT.shortcuts,
             GlobalConfig::DEFAULT.attempts,
