@@ -99,6 +99,12 @@ pub struct PlanConfig {
     /// default, 4 (three of EDMP's guides a wave, guides 1, 5 and 14 first), is a deviation
     /// from the paper, measured in docs/benchmark.md.
     pub waves: u8,
+    /// Waves the first stage runs at most before the global stage takes over (0 is refused;
+    /// `u8::MAX`: all of them). Fewer decide earlier that the prior's basin holds no free row:
+    /// the waves left unrun are work that a plan bound for the global stage never pays, and
+    /// whatever they would have freed is left to the global stage. The global stage's
+    /// reseeding always runs all its waves.
+    pub first_stage_waves: u8,
 }
 
 /// Which candidates the exact checker judges once the guides are done. The winner, its path
@@ -206,6 +212,7 @@ impl PlanConfig {
         judging: Judging::Winner,
         start_draws: u8::MAX,
         waves: 4,
+        first_stage_waves: u8::MAX,
     };
 }
 

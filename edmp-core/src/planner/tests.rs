@@ -64,6 +64,7 @@ fn config() -> PlanConfig {
         judging: Judging::Every,
         start_draws: u8::MAX,
         waves: 1,
+        first_stage_waves: u8::MAX,
     }
 }
 
@@ -614,19 +615,24 @@ fn blocked_scene() -> Scene<'static, 4> {
     s
 }
 
+/// The test config in three waves, with few steps: cheap enough to run every wave.
+fn three_short_waves() -> PlanConfig {
+    PlanConfig {
+        sampler: Sampler::Strided { steps: 3 },
+        guidance: GuidanceSchedule::Every { per_step: 2 },
+        refine: 4,
+        waves: 3,
+        ..config()
+    }
+}
+
 #[test]
 #[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
 fn each_wave_is_the_plan_of_its_guides_alone_and_rows_keep_the_callers_order() {
     // Nothing is free: every wave runs. Wave w, run with one Rng carried on, is a batch of
     // 4 rows following guides w, w + 3, w + 6, w + 9; its rows land where the guides are.
     let scene = blocked_scene();
-    let cfg = PlanConfig {
-        sampler: Sampler::Strided { steps: 3 },
-        guidance: GuidanceSchedule::Every { per_step: 2 },
-        refine: 4,
-        waves: 3,
-        ..config()
-    };
+    let cfg = three_short_waves();
     let mut scratch = Box::new(Scratch::<4>::new());
     let mut work = Box::new(Workspace::<12>::new());
     let mut waved = [[[0.0f32; JOINTS]; HORIZON]; 12];
@@ -665,6 +671,45 @@ fn each_wave_is_the_plan_of_its_guides_alone_and_rows_keep_the_callers_order() {
     plan.paths = waved;
     judge(&request(&scene, &cfg), &mut plan, &work.checks).unwrap();
     assert!(plan.verdicts.iter().all(|v| v.made && v.checked && !v.free));
+}
+
+#[test]
+#[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
+fn a_first_stage_limited_to_k_waves_runs_the_first_k_alone() {
+    // Nothing is free: unlimited, all three waves run; limited to one, the first wave's rows
+    // are the same bits and the other rows are never made; 0 waves are refused.
+    let scene = blocked_scene();
+    let cfg = three_short_waves();
+    let mut scratch = Box::new(Scratch::<4>::new());
+    let mut work = Box::new(Workspace::<12>::new());
+    let mut run = |first_stage_waves: u8| {
+        let mut paths = [[[0.0f32; JOINTS]; HORIZON]; 12];
+        let cfg = PlanConfig {
+            first_stage_waves,
+            ..cfg
+        };
+        denoise(
+            &request(&scene, &cfg),
+            &mut Rng::new(9),
+            &mut scratch,
+            &mut work,
+            &mut paths,
+        )
+        .map(|()| (paths, work.checks.skipped))
+    };
+    let (all, all_skipped) = run(u8::MAX).unwrap();
+    assert!(all_skipped.iter().all(|&s| !s));
+    let (one, one_skipped) = run(1).unwrap();
+    for r in 0..12 {
+        // Row r follows guide r; wave 0 holds guides 0, 3, 6, 9.
+        let first_wave = r % 3 == 0;
+        assert_eq!(one_skipped[r], !first_wave, "row {r}");
+        if first_wave {
+            assert_eq!(one[r], all[r], "row {r}: the first wave's bits");
+        }
+    }
+    assert_eq!(run(3).unwrap().0, all, "a limit of all the waves is no limit");
+    assert_eq!(run(0).unwrap_err(), Error::BadParameter);
 }
 
 #[test]

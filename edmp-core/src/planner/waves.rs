@@ -15,7 +15,8 @@ use crate::planner::workspace::{RowChecks, WaveChecks, WaveRows, Workspace};
 /// rows of `paths`; the exact checker certifies each wave's rows ([`certify`]) before the next
 /// runs, and the first wave with a free row ends it. The rows of waves not run are
 /// `RowChecks::skipped` in `work.checks` (never judged), and every row is put back in the
-/// caller's order (row r follows guide r / k whatever the waves). Shared by the first stage
+/// caller's order (row r follows guide r / k whatever the waves). At most `limit` waves run
+/// (0 is [`Error::BadParameter`]). Shared by the first stage
 /// ([`denoise_on`](crate::planner::denoise_on)) and the global stage's reseeding
 /// ([`crate::planner::global`]).
 pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: usize, const J: usize>(
@@ -23,10 +24,11 @@ pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: u
     req: &Request<'_, N, J>,
     work: &mut Workspace<B, CAP, J>,
     paths: &mut [Path<J>; B],
+    limit: usize,
     mut wave: impl FnMut(&[Guide], WaveRows<'_, J>, WaveChecks<'_>) -> Result<(), Error>,
 ) -> Result<(), Error> {
     let guides = req.guides;
-    if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) {
+    if B == 0 || guides.is_empty() || !B.is_multiple_of(guides.len()) || limit == 0 {
         return Err(Error::BadParameter);
     }
     let waves = req.config.waves_for(guides.len())?;
@@ -44,7 +46,8 @@ pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: u
     work.checks = RowChecks::NONE;
     let Workspace { eps, grads, checks, .. } = work;
     let mut ran = 0;
-    for w in 0..waves {
+    let runnable = waves.min(limit);
+    for w in 0..runnable {
         let (Some(wave_guides), Some(x), Some(e), Some(d), Some(free), Some(touched)) = (
             order.get(w * per_wave..(w + 1) * per_wave),
             paths.get_mut(w * rows..(w + 1) * rows),
@@ -59,7 +62,7 @@ pub(crate) fn in_waves<E: Executor, const B: usize, const N: usize, const CAP: u
         ran = w + 1;
         // A later wave runs only when no row of this one is free (the judge would check them
         // the same way; what is learnt here it does not check again).
-        if ran < waves && certify::<E, B, N, J>(exec, req, x, free, touched, 1)? > 0 {
+        if ran < runnable && certify::<E, B, N, J>(exec, req, x, free, touched, 1)? > 0 {
             break;
         }
     }

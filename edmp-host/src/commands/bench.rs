@@ -422,7 +422,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let records: Vec<Record> = records.into_iter().filter_map(Result::ok).collect();
     let refused: Vec<String> = refused.into_iter().filter_map(Result::err).collect();
     write_outputs(&args.out, &label, &records).map_err(input)?;
-    print!("{}", summary(&label, &records));
+    crate::commands::print_stdout(&summary(&label, &records)).map_err(input)?;
     if !refused.is_empty() {
         let path = args.out.join("refused.txt");
         std::fs::write(&path, refused.join("\n") + "\n").map_err(|e| input(format!("{}: {e}", path.display())))?;

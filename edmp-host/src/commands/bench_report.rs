@@ -283,6 +283,5 @@ pub fn run(args: &Args) -> Result<(), String> {
     }
     let path = args.out.join("report.md");
     std::fs::write(&path, &md).map_err(|e| format!("{}: {e}", path.display()))?;
-    print!("{md}");
-    Ok(())
+    crate::commands::print_stdout(&md)
 }

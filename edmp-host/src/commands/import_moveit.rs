@@ -40,9 +40,6 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let text = serde_json::to_string_pretty(&doc).map_err(|e| Failure::Input(e.to_string()))? + "\n";
     match &args.output {
         Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display()))),
-        None => {
-            print!("{text}");
-            Ok(())
-        }
+        None => crate::commands::print_stdout(&text).map_err(Failure::Input),
     }
 }

@@ -124,6 +124,10 @@ pub struct Tuning {
     /// guide, as EDMP. Default 4; with `--candidates`, 1 (every alternative made).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=12))]
     waves: Option<u8>,
+    /// Waves the first stage runs at most before the global stage takes over (default: all).
+    /// An experiment in deciding earlier (docs/benchmark.md).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=12))]
+    first_stage_waves: Option<u8>,
     /// Weight of a smoothness term in every guide's step (the bending energy of the path;
     /// 0: EDMP's guides; below 0.125). An ablation (docs/benchmark.md).
     #[arg(long, default_value_t = 0.0)]
@@ -235,6 +239,7 @@ impl Tuning {
                 self.start_draws
             },
             waves: self.waves.unwrap_or(PlanConfig::DEFAULT.waves),
+            first_stage_waves: self.first_stage_waves.unwrap_or(PlanConfig::DEFAULT.first_stage_waves),
             judging: if self.judge_every {
                 Judging::Every
             } else {
@@ -332,6 +337,10 @@ impl Tuning {
             Some(n) if n != PlanConfig::DEFAULT.waves => format!("{boxes}, {n} waves"),
             _ => boxes,
         };
+        let boxes = match self.first_stage_waves {
+            Some(n) => format!("{boxes}, first stage at most {n} waves"),
+            None => boxes,
+        };
         let boxes = if self.no_shortcut {
             format!("{boxes}, no shortcut")
         } else {
@@ -428,7 +437,7 @@ fn plan_for<const J: usize>(
     let text = serde_json::to_string_pretty(&out).map_err(|e| Failure::Input(e.to_string()))? + "\n";
     match &args.output {
         Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?,
-        None => print!("{text}"),
+        None => crate::commands::print_stdout(&text).map_err(Failure::Input)?,
     }
     if plan.is_free() {
         Ok(())
@@ -452,9 +461,9 @@ mod tests {
     }
 
     #[test]
-    fn the_flags_default_to_the_cores_shipped_configuration() {
+    fn the_flags_default_to_the_hosts_shipped_configuration() {
         let cli = Cli::parse_from(["edmp-host"]);
-        assert!(cli.tuning.config().is_ok_and(|c| c == PlanConfig::DEFAULT));
+        assert!(cli.tuning.config().is_ok_and(|c| c == crate::planning::HOST_CONFIG));
         let cli = Cli::parse_from(["edmp-host", "--step-limit", "0"]);
         assert!(cli.tuning.config().is_err());
         for steps in ["0", "51"] {

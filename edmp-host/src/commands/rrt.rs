@@ -79,9 +79,6 @@ fn plan_for<const J: usize>(
     let text = serde_json::to_string_pretty(&plan).map_err(|e| Failure::Input(e.to_string()))? + "\n";
     match &args.output {
         Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display()))),
-        None => {
-            print!("{text}");
-            Ok(())
-        }
+        None => crate::commands::print_stdout(&text).map_err(Failure::Input),
     }
 }
