@@ -111,6 +111,7 @@ fuzz_target!(|data: &[u8]| {
         judging: Judging::Every,
         start_draws: u8::MAX,
         waves: 1,
+        first_stage_waves: u8::MAX,
     };
     let count = [1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)];
     let mut scratch = Box::new(Scratch::<4>::new());
@@ -152,6 +153,12 @@ fuzz_target!(|data: &[u8]| {
     // Then the waves (an input that ends before it: one, as before; 0 is refused, 5 runs as
     // the most waves up to 5 that divide the guides).
     config.waves = [1, 2, 3, 4, 6, 12, 0, 5][usize::from(r.byte() % 8)];
+    // Then the first stage's cap on its waves (an input that ends before it: all, as before;
+    // 0 is refused).
+    config.first_stage_waves = match r.byte() {
+        0 => u8::MAX,
+        b => b % 5,
+    };
     let mut table = EDMP_GUIDES;
     for g in &mut table {
         g.smooth = if extra & 4 != 0 { 0.1 } else { 0.0 };
