@@ -6,7 +6,7 @@
 use crate::collision::convex::Convex;
 use crate::scene::Obstacle;
 use crate::surface::Surface;
-use crate::surface::bvh::Node;
+use crate::surface::bvh::{MAX_DEPTH, Node};
 use nalgebra::Vector3;
 
 /// The most boxes one surface gets.
@@ -80,20 +80,71 @@ fn fitted(surface: &Surface<'_>, node: &Node) -> Option<Obstacle> {
     let angle = 0.5 * libm::atan2f(2.0 * xy, xx - yy);
     let (s, c) = (libm::sinf(angle), libm::cosf(angle));
     let axes = [Vector3::new(c, s, 0.0), Vector3::new(-s, c, 0.0), Vector3::z()];
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for e in pieces {
-        for (k, a) in axes.iter().enumerate() {
-            hi[k] = hi[k].max(e.support(a).dot(a));
-            lo[k] = lo[k].min(e.support(&-a).dot(a));
-        }
-    }
+    // `e.support(-a).dot(a)` is exactly `-(e.support(-a).dot(-a))`: the lower side is the
+    // reach along `-a`, negated.
+    let hi = axes.map(|a| reach(surface, node, &a));
+    let lo = axes.map(|a| -reach(surface, node, &-a));
     let mid: [f32; 3] = core::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
     let center = axes[0] * mid[0] + axes[1] * mid[1] + axes[2] * mid[2];
     let dims: [f32; 3] = core::array::from_fn(|k| (hi[k] - lo[k]).max(MIN_SIDE));
     let half = 0.5 * angle;
     let quaternion = [libm::cosf(half), 0.0, 0.0, libm::sinf(half)];
     Obstacle::cuboid(center.into(), dims, quaternion).ok()
+}
+
+/// How far the pieces under `node` reach along `a`: the largest `e.support(a).dot(a)`, the
+/// same value a pass over every piece finds (a maximum does not depend on the order), found by
+/// visiting only the subtrees whose box could reach beyond the best so far. On a cloud of
+/// 200,000 balls this visits a few leaves instead of every ball.
+fn reach(surface: &Surface<'_>, node: &Node, a: &Vector3<f32>) -> f32 {
+    let (nodes, pieces) = (surface.nodes(), surface.pieces());
+    let mut best = f32::NEG_INFINITY;
+    let over = |run: &Node, best: f32| {
+        let end = run.first as usize + run.count as usize;
+        let run = pieces.get(run.first as usize..end).unwrap_or(&[]);
+        run.iter().fold(best, |best, e| {
+            let v = e.support(a).dot(a);
+            if v > best { v } else { best }
+        })
+    };
+    // Depth-first, the child that reaches further first; a pop pushes at most two, so a
+    // stack one deeper than the tree suffices, and a node that finds it full is read whole
+    // (its run holds its subtree's pieces).
+    let mut stack = [*node; MAX_DEPTH + 2];
+    let mut len: usize = 1;
+    while let Some(top) = len.checked_sub(1) {
+        len = top;
+        let Some(&n) = stack.get(top) else { break };
+        let bound = box_reach(&n, a);
+        // The box holds every support point; the slack absorbs the rounding of both sides.
+        if bound + 1e-5 * (1.0 + bound.abs()) < best {
+            continue;
+        }
+        let children = (nodes.get(n.left as usize), nodes.get(n.left as usize + 1));
+        match children {
+            (Some(&l), Some(&r)) if n.left != 0 && len + 2 <= stack.len() => {
+                let (near, far) = if box_reach(&l, a) > box_reach(&r, a) {
+                    (r, l)
+                } else {
+                    (l, r)
+                };
+                if let Some(slot) = stack.get_mut(len) {
+                    *slot = near;
+                }
+                if let Some(slot) = stack.get_mut(len + 1) {
+                    *slot = far;
+                }
+                len += 2;
+            }
+            _ => best = over(&n, best),
+        }
+    }
+    best
+}
+
+/// The largest `p.dot(a)` over the points `p` of a node's box.
+fn box_reach(n: &Node, a: &Vector3<f32>) -> f32 {
+    (0..3).fold(0.0, |sum, k| sum + (n.lo[k] * a[k]).max(n.hi[k] * a[k]))
 }
 
 #[cfg(test)]

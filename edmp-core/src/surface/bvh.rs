@@ -80,6 +80,12 @@ impl Key {
     pub const fn piece(&self) -> u32 {
         self.piece
     }
+
+    /// The piece's centroid as the key was made with it (a cloud's point itself: the caller
+    /// can make the ball from the key, without reading the point again).
+    pub const fn centroid(&self) -> [f32; 3] {
+        self.centroid
+    }
 }
 
 /// The box of the centroids of `keys`, as (lo, hi). Centroids are finite (pieces are

@@ -69,6 +69,8 @@ pub struct Surfaces {
     pub reduced: Vec<(usize, Reduced)>,
     /// The boxes the guides see around the pieces ([`covers`]).
     pub boxes: Vec<Obstacle>,
+    /// Per obstacle, whether it is a closed mesh ([`is_closed`]), found once for both ends.
+    closed: Vec<bool>,
     pieces: Vec<Element>,
     nodes: Vec<Node>,
 }
@@ -308,9 +310,11 @@ impl Source<'_> {
         }
     }
 
-    fn piece(&self, i: usize) -> Option<Result<Element, SurfaceError>> {
+    /// The piece of `key`, numbered `i` in this source: a ball is made from the key's centroid
+    /// (its point), so the points are not read again in the tree's (random) order.
+    fn piece(&self, key: &Key, i: usize) -> Option<Result<Element, SurfaceError>> {
         match self {
-            Source::Balls { points, radius, tag } => points.get(i).map(|p| Element::ball(*p, *radius, *tag)),
+            Source::Balls { radius, tag, .. } => Some(Element::ball(key.centroid(), *radius, *tag)),
             Source::Pieces(pieces) => pieces.get(i).map(|e| Ok(*e)),
         }
     }
@@ -437,7 +441,7 @@ pub fn build_surfaces<const J: usize>(
         let (Some(source), Some(first)) = (sources.get(s), firsts.get(s)) else {
             continue;
         };
-        if let Some(made) = source.piece(n - first) {
+        if let Some(made) = source.piece(key, n - first) {
             let index = obstacles.get(s).map_or(0, |o| o.index);
             pieces.push(made.map_err(|e| surface_error(e, &format!("obstacles[{index}]")))?);
         }
@@ -446,7 +450,15 @@ pub fn build_surfaces<const J: usize>(
     bound(&pieces, &mut nodes);
     drop(sources);
     drop(held);
+    let closed = obstacles
+        .iter()
+        .map(|o| match &o.kind {
+            SurfaceKind::Mesh { vertices, triangles } => is_closed(vertices, triangles),
+            SurfaceKind::Points { .. } => false,
+        })
+        .collect();
     let mut surfaces = Surfaces {
+        closed,
         obstacles,
         points_filtered,
         reduced,
@@ -465,7 +477,7 @@ pub fn build_surfaces<const J: usize>(
 /// Whether a mesh is closed: every edge is shared by exactly two of its (non-degenerate)
 /// triangles. A closed mesh's inside is part of the obstacle (docs/formats.md).
 pub fn is_closed(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
-    let mut edges: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    let mut edges = Vec::with_capacity(3 * triangles.len());
     for t in triangles {
         let corner = |i: u32| vertices.get(i as usize).map(|v| Vector3::from(*v));
         let (Some(a), Some(b), Some(c)) = (corner(t[0]), corner(t[1]), corner(t[2])) else {
@@ -475,17 +487,40 @@ pub fn is_closed(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
             continue;
         }
         for (i, j) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            *edges.entry((i.min(j), i.max(j))).or_default() += 1;
+            edges.push((i.min(j), i.max(j)));
         }
     }
-    !edges.is_empty() && edges.values().all(|&n| n == 2)
+    // Sorted, every edge must come exactly twice.
+    edges.sort_unstable();
+    !edges.is_empty() && edges.chunk_by(|a, b| a == b).all(|run| run.len() == 2)
 }
 
 /// Whether `p` lies inside a closed mesh: the parity of the mesh's triangles a ray from `p`
 /// crosses (a direction no axis-aligned face is parallel to).
 pub fn encloses(vertices: &[[f32; 3]], triangles: &[[u32; 3]], p: &Vector3<f32>) -> bool {
+    first_enclosed(vertices, triangles, core::slice::from_ref(p)).is_some()
+}
+
+/// The first of `points` inside a closed mesh ([`encloses`] for each, in one pass over the
+/// triangles: a triangle's edges and the ray's terms that do not depend on the point are
+/// computed once; points outside the mesh's box are never inside).
+pub fn first_enclosed(vertices: &[[f32; 3]], triangles: &[[u32; 3]], points: &[Vector3<f32>]) -> Option<usize> {
+    let (lo, hi) = vertices
+        .iter()
+        .fold(([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]), |(lo, hi), v| {
+            (
+                core::array::from_fn(|k| lo[k].min(v[k])),
+                core::array::from_fn(|k| hi[k].max(v[k])),
+            )
+        });
+    let candidates: Vec<usize> = (0..points.len())
+        .filter(|&i| (0..3).all(|k| points[i][k] >= lo[k] && points[i][k] <= hi[k]))
+        .collect();
+    if candidates.is_empty() {
+        return None;
+    }
     let d = Vector3::new(0.577_215_7, 0.313_717_4, 0.759_397_5).normalize();
-    let mut crossings = 0u32;
+    let mut crossings = vec![0u32; candidates.len()];
     for t in triangles {
         let corner = |i: u32| vertices.get(i as usize).map(|v| Vector3::from(*v));
         let (Some(a), Some(b), Some(c)) = (corner(t[0]), corner(t[1]), corner(t[2])) else {
@@ -498,16 +533,25 @@ pub fn encloses(vertices: &[[f32; 3]], triangles: &[[u32; 3]], p: &Vector3<f32>)
         if det.abs() < 1e-12 {
             continue;
         }
-        let s = p - a;
-        let u = s.dot(&h) / det;
-        let q = s.cross(&e1);
-        let v = d.dot(&q) / det;
-        let t = e2.dot(&q) / det;
-        if (0.0..=1.0).contains(&u) && v >= 0.0 && u + v <= 1.0 && t > 0.0 {
-            crossings += 1;
+        for (n, &i) in crossings.iter_mut().zip(&candidates) {
+            let s = points[i] - a;
+            let u = s.dot(&h) / det;
+            if !(0.0..=1.0).contains(&u) {
+                continue;
+            }
+            let q = s.cross(&e1);
+            let v = d.dot(&q) / det;
+            let t = e2.dot(&q) / det;
+            if v >= 0.0 && u + v <= 1.0 && t > 0.0 {
+                *n += 1;
+            }
         }
     }
-    crossings % 2 == 1
+    crossings
+        .iter()
+        .zip(&candidates)
+        .find(|(n, _)| *n % 2 == 1)
+        .map(|(_, &i)| i)
 }
 
 /// The first body of `robot` (by name) whose box centre lies inside a closed mesh at `q`, and
@@ -519,17 +563,24 @@ pub fn inside_closed_mesh<const J: usize>(
     finger: f32,
 ) -> Option<(&'static str, usize)> {
     let k = edmp_core::robot::kinematics::forward_with(robot, q, robot.finger_opening(finger)).ok()?;
-    for o in &surfaces.obstacles {
+    let bodies: Vec<(Vector3<f32>, &'static str)> = k
+        .boxes
+        .iter()
+        .zip(robot.body_names)
+        .enumerate()
+        .filter(|&(b, _)| moves(robot, b))
+        .map(|(_, (pose, name))| (pose.translation, *name))
+        .collect();
+    let centres: Vec<Vector3<f32>> = bodies.iter().map(|(c, _)| *c).collect();
+    for (o, &closed) in surfaces.obstacles.iter().zip(&surfaces.closed) {
         let SurfaceKind::Mesh { vertices, triangles } = &o.kind else {
             continue;
         };
-        if !is_closed(vertices, triangles) {
+        if !closed {
             continue;
         }
-        for (b, (pose, name)) in k.boxes.iter().zip(robot.body_names).enumerate() {
-            if moves(robot, b) && encloses(vertices, triangles, &pose.translation) {
-                return Some((name, o.index));
-            }
+        if let Some(i) = first_enclosed(vertices, triangles, &centres) {
+            return bodies.get(i).map(|(_, name)| (*name, o.index));
         }
     }
     None
@@ -539,6 +590,48 @@ pub fn inside_closed_mesh<const J: usize>(
 mod tests {
     use super::*;
     use edmp_core::surface::element::Piece;
+
+    /// The unit cube's 12 triangles, outward.
+    fn cube() -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+        let vertices = (0..8u32)
+            .map(|i| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32])
+            .collect();
+        let faces = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let triangles = faces.iter().flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]]).collect();
+        (vertices, triangles)
+    }
+
+    #[test]
+    fn a_cube_is_closed_and_holds_its_inside_an_open_one_does_not() {
+        let (vertices, mut triangles) = cube();
+        assert!(is_closed(&vertices, &triangles));
+        let points = [
+            Vector3::new(2.0, 0.5, 0.5),
+            Vector3::new(0.5, 0.5, 1.5),
+            Vector3::new(0.3, 0.6, 0.2),
+        ];
+        assert_eq!(first_enclosed(&vertices, &triangles, &points), Some(2));
+        assert!(encloses(&vertices, &triangles, &Vector3::new(0.9, 0.1, 0.5)));
+        assert!(!encloses(&vertices, &triangles, &Vector3::new(1.1, 0.5, 0.5)));
+        // A third triangle on an edge, or a missing one, opens it.
+        triangles.push([0, 2, 7]);
+        assert!(!is_closed(&vertices, &triangles));
+        triangles.truncate(11);
+        assert!(!is_closed(&vertices, &triangles));
+        // A degenerate triangle is ignored, an index out of range is not a closed mesh.
+        let (vertices, mut triangles) = cube();
+        triangles.push([0, 0, 1]);
+        assert!(is_closed(&vertices, &triangles));
+        triangles.push([0, 1, 8]);
+        assert!(!is_closed(&vertices, &triangles));
+    }
 
     #[test]
     fn a_cloud_beyond_the_capacity_is_reduced_to_cover_it_and_a_mesh_beside_it_is_kept() {
