@@ -386,7 +386,23 @@ pub(crate) fn parse(bytes: &[u8], faces: bool) -> Result<PlyData, FileError> {
             let start = *pos;
             let need = element.count.saturating_mul(stride);
             let rows = bytes.get(start..start.saturating_add(need)).unwrap_or(&[]);
+            // The usual cloud, x, y and z as f32: read as they are (the general path below
+            // gives the same values, and the error of a row that is not finite).
+            let f32_at = |chunk: &[u8], offset: usize| {
+                chunk
+                    .get(offset..offset + 4)
+                    .and_then(|b| <[u8; 4]>::try_from(b).ok())
+                    .map_or(f32::NAN, f32::from_le_bytes)
+            };
+            let all_f32 = xyz.iter().all(|f| f.scalar == Scalar::F32);
             for (row, chunk) in rows.chunks_exact(stride).enumerate() {
+                if all_f32 {
+                    let point = xyz.map(|f| f32_at(chunk, f.offset));
+                    if point.iter().all(|v| v.is_finite()) {
+                        data.vertices.push(point);
+                        continue;
+                    }
+                }
                 let mut point = [0.0f32; 3];
                 for (slot, field) in point.iter_mut().zip(&xyz) {
                     let (offset, s) = (field.offset, field.scalar);
