@@ -426,11 +426,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if !refused.is_empty() {
         let path = args.out.join("refused.txt");
         std::fs::write(&path, refused.join("\n") + "\n").map_err(|e| input(format!("{}: {e}", path.display())))?;
-        println!(
-            "\n{} problems refused as invalid input, not planned: {}",
+        crate::commands::print_stdout(&format!(
+            "\n{} problems refused as invalid input, not planned: {}\n",
             refused.len(),
             path.display()
-        );
+        ))
+        .map_err(input)?;
     }
     Ok(())
 }

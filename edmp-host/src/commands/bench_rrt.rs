@@ -66,11 +66,10 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 pub fn run(args: &Args) -> Result<(), String> {
     let families = crate::commands::gen_suite::read_folder(&args.problems, usize::MAX)?;
     let budget = Duration::from_millis(args.budget_ms);
-    println!(
-        "| family | solved (≤ {} ms) | median time (ms) | p95 time (ms) | mean path length (rad) |",
+    crate::commands::print_stdout(&format!(
+        "| family | solved (≤ {} ms) | median time (ms) | p95 time (ms) | mean path length (rad) |\n|---|---|---|---|---|\n",
         args.budget_ms
-    );
-    println!("|---|---|---|---|---|");
+    ))?;
     for (name, files) in families {
         let bar = ProgressBar::new(files.len() as u64).with_message(name.clone());
         bar.set_style(ProgressStyle::with_template("{msg:>13} [{bar:40}] {pos}/{len}").map_err(|e| e.to_string())?);
@@ -90,15 +89,15 @@ pub fn run(args: &Args) -> Result<(), String> {
         times.sort_by(f64::total_cmp);
         let mean_length =
             solved.iter().filter_map(|o| o.length).map(f64::from).sum::<f64>() / solved.len().max(1) as f64;
-        println!(
-            "| {name} | {}/{} ({:.0} %) | {:.1} | {:.1} | {:.2} |",
+        crate::commands::print_stdout(&format!(
+            "| {name} | {}/{} ({:.0} %) | {:.1} | {:.1} | {:.2} |\n",
             solved.len(),
             outcomes.len(),
             100.0 * solved.len() as f64 / outcomes.len().max(1) as f64,
             percentile(&times, 0.5),
             percentile(&times, 0.95),
             mean_length
-        );
+        ))?;
     }
     Ok(())
 }

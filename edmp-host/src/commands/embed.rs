@@ -240,7 +240,7 @@ where
         let plan = plan_like_firmware(robot, network, &bytes).map_err(at)?;
         let status = if plan.is_free() { "success" } else { "collision" };
         let line = format!("{name} {status} {:016x}", plan.fingerprint());
-        println!("{line}  ({} bytes)", bytes.len());
+        crate::commands::print_stdout(&format!("{line}  ({} bytes)\n", bytes.len())).map_err(input)?;
         let _ = writeln!(expected, "{line}");
         let timed = time_like_firmware(robot, &bytes, &plan).map_err(at)?;
         let _ = writeln!(

@@ -9,6 +9,7 @@
 //! training trajectories instead of a suite (an arm without suites yet).
 
 use crate::arm::{Arm, with_arm};
+use crate::commands::print_stdout;
 use crate::commands::render::Canvas;
 use crate::formats::json::{Goal, read_problem};
 use crate::metrics::{Roughness, roughness, step_norm};
@@ -247,21 +248,19 @@ fn measure<const J: usize>(robot: &'static Robot<f32, J>, network: &Network<J>, 
         return Err(format!("{}: no problems found", args.problems.display()));
     }
     let empty = Scene::<1>::new();
-    println!(
+    print_stdout(&format!(
         "Unguided prior of the {}, {} problems x {BATCH} trajectories ({} parameters, {} MAC per forward); \
-         roughness in radians (joint-space L2 between adjacent waypoints), time per problem on one core.\n",
+         roughness in radians (joint-space L2 between adjacent waypoints), time per problem on one core.\n\n\
+         | source | trajectories | AR | MRESG | RF2W | RL2W | outside hard limits % | self-colliding % | ms median / p95 |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
         robot.name,
         problems.len(),
         edmp_core::prior::PARAMETERS,
         edmp_core::prior::MACS
-    );
-    println!(
-        "| source | trajectories | AR | MRESG | RF2W | RL2W | outside hard limits % | self-colliding % | ms median / p95 |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    ))?;
     if !held.is_empty() {
         let q: Vec<Quality> = held.par_iter().map(|x| quality(robot, x, &empty)).collect();
-        println!("{}", row("training data (held out)", &q, None));
+        print_stdout(&format!("{}\n", row("training data (held out)", &q, None)))?;
     }
     // The plot shows the problem with the longest way from start to goal.
     let shown = (0..problems.len())
@@ -320,10 +319,10 @@ fn measure<const J: usize>(robot: &'static Robot<f32, J>, network: &Network<J>, 
         }
         times.sort_by(f64::total_cmp);
         let q: Vec<Quality> = paths.par_iter().flatten().map(|x| quality(robot, x, &empty)).collect();
-        println!(
-            "{}",
+        print_stdout(&format!(
+            "{}\n",
             row(&label, &q, Some((percentile(&times, 0.5), percentile(&times, 0.95))))
-        );
+        ))?;
         if condition {
             plotted.push((sampler, paths[shown]));
         }
@@ -333,12 +332,12 @@ fn measure<const J: usize>(robot: &'static Robot<f32, J>, network: &Network<J>, 
         let last = plotted.last().map(|p| p.1);
         if let (Some(a), Some(b)) = (first, last) {
             plot(robot, path, &a, &b)?;
-            println!(
-                "\nwrote {} (joints top to bottom; blue: {}, orange: {}; grey: hard limits)",
+            print_stdout(&format!(
+                "\nwrote {} (joints top to bottom; blue: {}, orange: {}; grey: hard limits)\n",
                 path.display(),
                 name(plotted[0].0),
                 name(plotted[plotted.len() - 1].0)
-            );
+            ))?;
         }
     }
     Ok(())
