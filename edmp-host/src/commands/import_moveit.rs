@@ -38,8 +38,5 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     })?;
     validate(&doc).map_err(Failure::Input)?;
     let text = serde_json::to_string_pretty(&doc).map_err(|e| Failure::Input(e.to_string()))? + "\n";
-    match &args.output {
-        Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display()))),
-        None => crate::commands::print_stdout(&text).map_err(Failure::Input),
-    }
+    crate::commands::write_document(args.output.as_deref(), &text).map_err(Failure::Input)
 }

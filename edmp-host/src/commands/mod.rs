@@ -26,3 +26,12 @@ pub(crate) fn print_stdout(text: &str) -> Result<(), String> {
         _ => Ok(()),
     }
 }
+
+/// Writes a command's document to `output` when given (`-o FILE`), else to standard output
+/// ([`print_stdout`]); an error names the file.
+pub(crate) fn write_document(output: Option<&std::path::Path>, text: &str) -> Result<(), String> {
+    match output {
+        Some(path) => std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display())),
+        None => print_stdout(text),
+    }
+}

@@ -435,10 +435,7 @@ fn plan_for<const J: usize>(
         eprintln!("edmp-host: no trajectory: the plan collides, so it is not timed");
     }
     let text = serde_json::to_string_pretty(&out).map_err(|e| Failure::Input(e.to_string()))? + "\n";
-    match &args.output {
-        Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?,
-        None => crate::commands::print_stdout(&text).map_err(Failure::Input)?,
-    }
+    crate::commands::write_document(args.output.as_deref(), &text).map_err(Failure::Input)?;
     if plan.is_free() {
         Ok(())
     } else {

@@ -77,8 +77,5 @@ fn plan_for<const J: usize>(
         "timing_ms": {"total": total_ms, "search": planned.elapsed.as_secs_f64() * 1e3},
     });
     let text = serde_json::to_string_pretty(&plan).map_err(|e| Failure::Input(e.to_string()))? + "\n";
-    match &args.output {
-        Some(path) => std::fs::write(path, text).map_err(|e| Failure::Input(format!("{}: {e}", path.display()))),
-        None => crate::commands::print_stdout(&text).map_err(Failure::Input),
-    }
+    crate::commands::write_document(args.output.as_deref(), &text).map_err(Failure::Input)
 }
