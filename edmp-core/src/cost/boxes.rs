@@ -14,6 +14,7 @@ pub struct Aabb {
 
 impl Aabb {
     /// The smallest box holding both.
+    #[inline(always)]
     pub fn union(&self, other: &Self) -> Self {
         Self {
             min: self.min.inf(&other.min),

@@ -114,6 +114,7 @@ impl ObstacleBox {
     }
 
     /// A world point in the frame.
+    #[inline(always)]
     fn local(&self, p: &Vector3<f32>) -> Vector3<f32> {
         match &self.axes {
             Some(a) => a.transpose() * (p - self.origin),
@@ -123,11 +124,13 @@ impl ObstacleBox {
 
     /// Whether a robot box centred at `c` (in the frame) with `|half| = radius` may reach the
     /// box along axis `k`: its AABB's half extent on any axis is at most `radius`.
+    #[inline(always)]
     fn apart_on(&self, c: &Vector3<f32>, radius: f32, k: usize) -> bool {
         c[k] - radius > self.bounds.max[k] || c[k] + radius < self.bounds.min[k]
     }
 
     /// World direction of the frame's axis `k`.
+    #[inline(always)]
     fn axis(&self, k: usize) -> Vector3<f32> {
         // Constant column indices: no run-time bounds check (and no panic path) in nalgebra.
         match (&self.axes, k) {
@@ -177,6 +180,7 @@ impl RobotBox {
     /// The box's AABB in the obstacle's frame given its centre `c` there, with the corners
     /// that set its bounds: along axis `k` the highest corner takes `+half_j` exactly where
     /// `M[k][j] > 0`.
+    #[inline(always)]
     fn aabb_in(&self, o: &ObstacleBox, c: Vector3<f32>) -> (Aabb, [[u8; 3]; 2]) {
         let r = match &o.axes {
             Some(a) => a.transpose() * self.pose.rotation,
@@ -213,6 +217,7 @@ fn held_local_pose(held: &Obstacle) -> Pose<f32> {
 }
 
 /// Intersection volume of `a` with `o` and its gradient with respect to `a`'s bounds.
+#[inline(always)]
 fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector3<f32>)> {
     let overlap = a.max.inf(&o.max) - a.min.sup(&o.min);
     if overlap.x <= 0.0 || overlap.y <= 0.0 || overlap.z <= 0.0 {
@@ -315,6 +320,7 @@ impl<const J: usize> Waypoint<J> {
 
 impl Pulls {
     /// Adds the gradient on one bound (axis `k` of the obstacle's frame) to the corner that set it.
+    #[inline(always)]
     fn add(&mut self, slot: usize, corner: u8, o: &ObstacleBox, k: usize, g: f32) {
         let slot = slot % SLOTS;
         if self.touched & (1 << slot) == 0 {
@@ -548,6 +554,7 @@ fn finish<const H: usize, const J: usize>(
 }
 
 /// Whether two boxes overlap with positive volume.
+#[inline(always)]
 fn overlaps(a: &Aabb, b: &Aabb) -> bool {
     let (lo, hi) = (a.min.sup(&b.min), a.max.inf(&b.max));
     hi.x > lo.x && hi.y > lo.y && hi.z > lo.z

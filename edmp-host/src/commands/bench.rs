@@ -131,6 +131,9 @@ pub struct Record {
     /// was free or no global stage was asked for).
     #[serde(default)]
     pub global_ms: Option<f64>,
+    /// Milliseconds in each phase of the core's pipeline (EDMP; absent in older runs).
+    #[serde(default)]
+    pub phases: Option<PhaseMs>,
     /// First-stage waves that ran (EDMP): up to the one whose row won for a `diffusion` plan,
     /// all of them for the others (the global stage runs only after the last).
     #[serde(default)]
@@ -141,6 +144,34 @@ pub struct Record {
     pub acsm: Option<f64>,
     /// The returned path (50 × the arm's joints; empty without a path).
     pub waypoints: Vec<Vec<f32>>,
+}
+
+/// Where one EDMP plan's time went, milliseconds per phase of the pipeline, in its order.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+pub struct PhaseMs {
+    /// IK for a pose goal.
+    pub ik: f64,
+    /// The first stage: the waves of guided denoising with their refinement and checks.
+    pub first_stage: f64,
+    /// The judge's verdicts and the winner.
+    pub judge: f64,
+    /// The global stage (next to nothing when a first-stage row was free).
+    pub global: f64,
+    /// Shortening the free winner.
+    pub shortcut: f64,
+}
+
+impl PhaseMs {
+    /// The phases' names and times, in the pipeline's order.
+    fn named(&self) -> [(&'static str, f64); 5] {
+        [
+            ("IK", self.ik),
+            ("first stage", self.first_stage),
+            ("judge", self.judge),
+            ("global stage", self.global),
+            ("shortcut", self.shortcut),
+        ]
+    }
 }
 
 impl Record {
@@ -242,6 +273,13 @@ fn run_edmp_for<const J: usize>(
         guide: Some(guides[plan.best / per_guide].id),
         stage: Some(plan.stage.name().to_owned()),
         global_ms: Some(planned.global_ms),
+        phases: Some(PhaseMs {
+            ik: planned.ik_ms,
+            first_stage: planned.denoise_ms,
+            judge: planned.select_ms,
+            global: planned.global_ms,
+            shortcut: planned.shortcut_ms,
+        }),
         waves: u8::try_from(waves_run).ok(),
         candidates,
         acsm: acsm(&batch),
@@ -304,6 +342,7 @@ fn run_rrt_for<const J: usize>(
         guide: None,
         stage: None,
         global_ms: None,
+        phases: None,
         waves: None,
         candidates: Vec::new(),
         acsm: None,
@@ -448,6 +487,33 @@ fn summary(label: &str, records: &[Record]) -> String {
     out.push('\n');
     out += &stage_table(records);
     out += &tail_table(records);
+    out += &phase_table(records);
+    out
+}
+
+/// Where the time goes by phase of the pipeline (EDMP runs that recorded phases; empty
+/// otherwise): each phase's median and mean per plan and its share of all planning time.
+fn phase_table(records: &[Record]) -> String {
+    let phases: Vec<PhaseMs> = records.iter().filter_map(|r| r.phases).collect();
+    if phases.is_empty() {
+        return String::new();
+    }
+    let total: f64 = phases.iter().flat_map(|p| p.named()).map(|(_, ms)| ms).sum();
+    let mut out = format!(
+        "\nBy phase, over {} plans:\n\n| phase | median ms | mean ms | share of all time |\n|---|---|---|---|\n",
+        phases.len()
+    );
+    for (i, (name, _)) in PhaseMs::default().named().iter().enumerate() {
+        let mut times: Vec<f64> = phases.iter().map(|p| p.named()[i].1).collect();
+        times.sort_by(f64::total_cmp);
+        let sum: f64 = times.iter().sum();
+        out += &format!(
+            "| {name} | {:.2} | {:.2} | {:.1} % |\n",
+            percentile(&times, 0.5),
+            sum / times.len() as f64,
+            100.0 * sum / total.max(f64::MIN_POSITIVE),
+        );
+    }
     out
 }
 
@@ -619,6 +685,7 @@ mod tests {
             guide: None,
             stage: stage.map(str::to_owned),
             global_ms: None,
+            phases: None,
             waves,
             candidates: Vec::new(),
             acsm: None,
@@ -656,5 +723,25 @@ mod tests {
         );
         // RRT-Connect's records have no stage: no table.
         assert_eq!(tail_table(&[record(None, None, 5.0)]), "");
+    }
+
+    #[test]
+    fn the_phase_table_gives_each_phase_its_median_mean_and_share() {
+        let phased = |first_stage: f64, shortcut: f64| Record {
+            phases: Some(PhaseMs {
+                first_stage,
+                shortcut,
+                ..PhaseMs::default()
+            }),
+            ..record(Some("diffusion"), Some(1), first_stage + shortcut)
+        };
+        // 40 ms of first stage and 10 of shortcut in all: 80 % and 20 %.
+        let table = phase_table(&[phased(10.0, 2.0), phased(10.0, 4.0), phased(20.0, 4.0)]);
+        assert!(table.contains("over 3 plans"), "{table}");
+        assert!(table.contains("| first stage | 10.00 | 13.33 | 80.0 % |"), "{table}");
+        assert!(table.contains("| shortcut | 4.00 | 3.33 | 20.0 % |"), "{table}");
+        assert!(table.contains("| global stage | 0.00 | 0.00 | 0.0 % |"), "{table}");
+        // Runs without phases (RRT-Connect, older records): no table.
+        assert_eq!(phase_table(&[record(None, None, 5.0)]), "");
     }
 }
