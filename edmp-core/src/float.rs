@@ -47,9 +47,90 @@ pub fn sqrt_below(x: f32) -> f32 {
     newton * 0.999
 }
 
+/// `libm::expf` of every lane, the same bits: vertical SIMD. Each lane runs libm's own
+/// reduction and polynomial (FreeBSD's `e_expf.c`) with its branches turned into selects, so an
+/// x86-64 build computes eight lanes in a few AVX instructions where the scalar calls each
+/// mispredict a branch on `|x|`; a lane outside the range those branches share (`|x|` ≤ 2⁻¹⁴,
+/// beyond ±87.3, NaN) takes `libm::expf` itself. A Cortex-M runs the same lanes one by one.
+pub fn expf_lanes<const L: usize>(x: &[f32; L]) -> [f32; L] {
+    // libm 0.2's constants for `expf`.
+    const HALF: [f32; 2] = [0.5, -0.5];
+    const LN2_HI: f32 = 6.931_457_5e-1;
+    const LN2_LO: f32 = 1.428_606_8e-6;
+    const INV_LN2: f32 = 1.442_695_f32;
+    const P1: f32 = 1.666_662_5e-1;
+    const P2: f32 = -2.766_733_3e-3;
+    let mut out = [0.0f32; L];
+    for (y, &x) in out.iter_mut().zip(x) {
+        let hx = x.to_bits() & 0x7fff_ffff;
+        let sign = x.to_bits() >> 31;
+        // |x| > 1.5 ln 2: k rounds x / ln 2; above ½ ln 2: k = ±1; else k = 0, where the
+        // reduction below leaves x as it is (x − 0·ln2hi = x, lo = 0).
+        let k = if hx > 0x3f85_1592 {
+            (INV_LN2 * x + if sign == 0 { HALF[0] } else { HALF[1] }) as i32
+        } else if hx > 0x3eb1_7218 {
+            1 - 2 * sign as i32
+        } else {
+            0
+        };
+        let kf = k as f32;
+        let hi = x - kf * LN2_HI;
+        let lo = kf * LN2_LO;
+        let r = hi - lo;
+        let rr = r * r;
+        let c = r - rr * (P1 + rr * P2);
+        let e = 1.0 + (r * c / (2.0 - c) - lo + hi);
+        // libm's `scalbnf(e, k)`: for k in [−126, 127] one product with 2^k (1 for k = 0).
+        *y = e * f32::from_bits(((0x7f + k.clamp(-126, 127)) as u32) << 23);
+    }
+    for (y, &x) in out.iter_mut().zip(x) {
+        let hx = x.to_bits() & 0x7fff_ffff;
+        if hx <= 0x3900_0000 || hx >= 0x42ae_ac50 {
+            *y = libm::expf(x);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn expf_lanes_is_libms_expf_bit_for_bit() {
+        // Every 61st f32 bit pattern (positive and negative, NaNs and infinities included), in
+        // lanes of 8, and the boundaries of libm's branches.
+        let mut checked = 0u32;
+        let mut lanes = [0.0f32; 8];
+        let edges = [
+            0x3900_0000u32,
+            0x3eb1_7218,
+            0x3f85_1592,
+            0x42ae_ac50,
+            0x42b1_7218,
+            0x42cf_f1b5,
+        ];
+        let patterns = (0..=u32::MAX).step_by(61).chain(
+            edges
+                .iter()
+                .flat_map(|&e| (e - 2..=e + 2).flat_map(|b| [b, b | 0x8000_0000])),
+        );
+        for (i, bits) in patterns.enumerate() {
+            lanes[i % 8] = f32::from_bits(bits);
+            if i % 8 == 7 {
+                for (got, x) in expf_lanes(&lanes).iter().zip(&lanes) {
+                    assert_eq!(
+                        got.to_bits(),
+                        libm::expf(*x).to_bits(),
+                        "expf({x:e}) ({:#x})",
+                        x.to_bits()
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 70_000_000, "{checked}");
+    }
 
     #[test]
     fn clamp_has_f32_clamps_bits_and_never_panics() {
