@@ -6,7 +6,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use edmp_core::rng::Rng;
 use edmp_core::robot::ik::{IkConfig, solve};
 use edmp_core::robot::kinematics::{CORNERS, CornerGradient, forward};
-use edmp_core::robot::{BODIES, JOINTS, PANDA};
+use edmp_core::robot::{JOINTS, MAX_BODIES, PANDA};
 use edmp_core::scene::Scene;
 use nalgebra::Vector3;
 
@@ -28,7 +28,9 @@ fn configurations(n: usize) -> Vec<[f32; JOINTS]> {
 }
 
 fn gradient() -> CornerGradient<f32> {
-    let u = unit_sequence(2, BODIES * CORNERS * 3);
+    // A corner gradient has a slot for every body of the largest arm compiled in (the Panda's
+    // adjoint reads its own).
+    let u = unit_sequence(2, MAX_BODIES * CORNERS * 3);
     core::array::from_fn(|b| {
         core::array::from_fn(|c| {
             let i = (b * CORNERS + c) * 3;

@@ -38,6 +38,7 @@ impl<T: Real> Pose<T> {
     }
 
     /// `self ∘ local`: a pose given in this frame, expressed in the world.
+    #[inline]
     pub fn compose(&self, rotation: &Matrix3<T>, translation: &Vector3<T>) -> Self {
         Self {
             rotation: self.rotation * rotation,
@@ -52,6 +53,7 @@ impl<T: Real> Pose<T> {
     }
 
     /// A point given in this frame, expressed in the world.
+    #[inline]
     pub fn transform_point(&self, p: &Vector3<T>) -> Vector3<T> {
         self.rotation * p + self.translation
     }
