@@ -273,6 +273,7 @@ impl<const J: usize> Placed<'_, J> {
 
 /// Robot shapes per state, at most: every collision body, then the held object.
 const SLOTS: usize = MAX_BODIES + 1;
+const _: () = assert!(SLOTS <= u32::BITS as usize, "one bit per shape in `Prepared::moving`");
 
 /// The separating direction last found for each pair, carried from one state of a trajectory
 /// to the next (zero: none yet).
@@ -362,6 +363,9 @@ struct Prepared<'s, const J: usize, const N: usize> {
     obstacles: [Solid; N],
     obstacle_radius: [f32; N],
     shapes: usize,
+    /// Bit `b`: shape `b` moves with the joints ([`moves`]; the walk to the root was an eighth
+    /// of a state's test when it ran per state).
+    moving: u32,
     radius: [f32; SLOTS],
     pairs: [(u8, u8); PAIRS],
     pair_count: usize,
@@ -416,6 +420,9 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
                 push((a as u8, bodies as u8));
             }
         }
+        let moving = (0..shapes)
+            .filter(|&b| moves(robot, b))
+            .fold(0u32, |mask, b| mask | 1u32.checked_shl(b as u32).unwrap_or(0));
         Ok(Self {
             robot,
             scene,
@@ -423,6 +430,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             obstacles,
             obstacle_radius,
             shapes,
+            moving,
             radius,
             pairs,
             pair_count,
@@ -454,7 +462,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
         // Use up every pair's slack; only pairs left without any are tested.
         let mut untested = false;
         let robot = self.robot;
-        for b in (0..self.shapes).filter(|&b| moves(robot, b)) {
+        for b in (0..self.shapes).filter(|&b| self.moving >> b & 1 == 1) {
             for s in self.slack.obstacle[b % SLOTS].iter_mut().take(count) {
                 *s -= moved[b % SLOTS];
                 untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
@@ -504,7 +512,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             margin,
             self_margin,
         };
-        for b in (0..self.shapes).filter(|&b| moves(robot, b)) {
+        for b in (0..self.shapes).filter(|&b| self.moving >> b & 1 == 1) {
             let candidates = self
                 .obstacles
                 .iter()
