@@ -70,7 +70,7 @@ fn main() {
         if !panda {
             let _ = write!(
                 source,
-                "\nstatic TRAINED: Network<JOINTS> = Network {{ name: {:?}, net: &NET, blob: WEIGHT_BLOB, fnv1a: WEIGHTS_FNV1A }};\n\
+                "\nstatic TRAINED: Network<JOINTS> = Network {{ name: {:?}, net: &NET, blob: WEIGHT_BLOB, fnv1a: WEIGHTS_FNV1A, wave_budget: None }};\n\
                  /// The network trained on this arm's data (`{folder}`).\n\
                  pub static NETWORK: Option<&Network<JOINTS>> = Some(&TRAINED);\n\
                  const _: () = assert!(\n    LEVELS == weights::LEVELS && same(&DIMS, &weights::DIMS) && same(&LENGTHS, &weights::LENGTHS)\n    \

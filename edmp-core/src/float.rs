@@ -57,7 +57,7 @@ pub fn expf_lanes<const L: usize>(x: &[f32; L]) -> [f32; L] {
     const HALF: [f32; 2] = [0.5, -0.5];
     const LN2_HI: f32 = 6.931_457_5e-1;
     const LN2_LO: f32 = 1.428_606_8e-6;
-    const INV_LN2: f32 = 1.442_695_f32;
+    const INV_LN2: f32 = core::f32::consts::LOG2_E; // 0x3fb8aa3b, libm's INV_LN2
     const P1: f32 = 1.666_662_5e-1;
     const P2: f32 = -2.766_733_3e-3;
     let mut out = [0.0f32; L];

@@ -112,6 +112,7 @@ fuzz_target!(|data: &[u8]| {
         start_draws: u8::MAX,
         waves: 1,
         first_stage_waves: u8::MAX,
+        wave_budget: None,
     };
     let count = [1, 2, 3, 4, 6, 12][usize::from(r.byte() % 6)];
     let mut scratch = Box::new(Scratch::<4>::new());
@@ -158,6 +159,12 @@ fuzz_target!(|data: &[u8]| {
     config.first_stage_waves = match r.byte() {
         0 => u8::MAX,
         b => b % 5,
+    };
+    // Then the bound on the waves in guide boxes × waves (an input that ends before it: none,
+    // as before; any budget runs at least one wave of each stage).
+    config.wave_budget = match r.byte() {
+        0 => None,
+        b => Some(u16::from(b) % 80),
     };
     let mut table = EDMP_GUIDES;
     for g in &mut table {

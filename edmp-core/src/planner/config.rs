@@ -105,6 +105,14 @@ pub struct PlanConfig {
     /// whatever they would have freed is left to the global stage. The global stage's
     /// reseeding always runs all its waves.
     pub first_stage_waves: u8,
+    /// A bound on the waves the first stage and, apart, the global stage's reseeding run, in
+    /// guide boxes × waves (`None`: the prior's own, [`Network::wave_budget`](crate::prior::Network::wave_budget);
+    /// `u16::MAX`: no bound in practice). A wave's work grows with the boxes its guides cost,
+    /// so a scene of many boxes runs fewer waves of the first stage before the global stage
+    /// takes over, and fewer reseeding waves before the search's own path is kept; at least
+    /// one wave of each always runs ([`waves_within`]). Each wave's own work is bounded by its
+    /// steps, so this bounds the plan's guided work.
+    pub wave_budget: Option<u16>,
 }
 
 /// Which candidates the exact checker judges once the guides are done. The winner, its path
@@ -213,7 +221,21 @@ impl PlanConfig {
         start_draws: u8::MAX,
         waves: 4,
         first_stage_waves: u8::MAX,
+        wave_budget: None,
     };
+}
+
+/// The Panda prior's wave budget ([`PlanConfig::wave_budget`]), guide boxes × waves: a scene
+/// of up to 6 boxes runs all four waves of each stage, 7-8 boxes three, 9-12 two, more one
+/// (chosen on the Panda's in-distribution suite, where it lowered p95 and p99 the most without
+/// moving the median; docs/benchmark.md, "Bounding the waves"). The other arms' priors free
+/// fewer rows per wave and run every wave.
+pub const WAVE_BUDGET: u16 = 24;
+
+/// The waves one stage may run under `budget` (guide boxes × waves) in a scene whose guides
+/// cost `boxes` boxes: at least 1; `usize::MAX` without a budget.
+pub fn waves_within(budget: Option<u16>, boxes: usize) -> usize {
+    budget.map_or(usize::MAX, |budget| (usize::from(budget) / boxes.max(1)).max(1))
 }
 
 /// Settings of the global stage.

@@ -48,7 +48,7 @@ pub fn denoise_on<E: Executor, const B: usize, const N: usize, const C: usize, c
     req.config.sampler.validate()?;
     check_joints(req.start)?;
     check_joints(req.goal)?;
-    let limit = usize::from(req.config.first_stage_waves);
+    let limit = usize::from(req.config.first_stage_waves).min(req.waves_within_budget());
     in_waves(exec, req, work, paths, limit, |wave_guides, rows, checks| {
         denoise_wave::<E, B, N, C, J>(exec, &req.with_guides(wave_guides), rng, scratches, rows, checks)
     })

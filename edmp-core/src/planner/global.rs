@@ -109,7 +109,7 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
         req,
         work,
         &mut plan.paths,
-        usize::MAX,
+        req.waves_within_budget(),
         |wave_guides, (paths, eps, grads), checks| {
             let wave = req.with_guides(wave_guides);
             for x in paths.iter_mut() {

@@ -1,7 +1,7 @@
 //! One planning request: what every stage of the pipeline reads and none of them changes.
 
 use crate::guidance::guides::Guide;
-use crate::planner::config::PlanConfig;
+use crate::planner::config::{PlanConfig, waves_within};
 use crate::prior::Network;
 use crate::robot::kinematics::Joints;
 use crate::robot::{JOINTS, Robot};
@@ -33,5 +33,13 @@ impl<'a, const N: usize, const J: usize> Request<'a, N, J> {
     /// ([`PlanConfig::waves`]) runs its own guides on its own rows.
     pub fn with_guides(&self, guides: &'a [Guide]) -> Self {
         Self { guides, ..*self }
+    }
+
+    /// The waves one stage (the first, or the global stage's reseeding) may run: the wave
+    /// budget (the config's, else the prior's) over the scene's guide boxes
+    /// ([`PlanConfig::wave_budget`]).
+    pub fn waves_within_budget(&self) -> usize {
+        let budget = self.config.wave_budget.or(self.network.wave_budget);
+        waves_within(budget, self.scene.guide_obstacles().len())
     }
 }

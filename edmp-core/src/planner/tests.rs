@@ -65,6 +65,7 @@ fn config() -> PlanConfig {
         start_draws: u8::MAX,
         waves: 1,
         first_stage_waves: u8::MAX,
+        wave_budget: None,
     }
 }
 
@@ -710,6 +711,48 @@ fn a_first_stage_limited_to_k_waves_runs_the_first_k_alone() {
     }
     assert_eq!(run(3).unwrap().0, all, "a limit of all the waves is no limit");
     assert_eq!(run(0).unwrap_err(), Error::BadParameter);
+}
+
+#[test]
+#[cfg_attr(miri, ignore = "the whole planner: hours under Miri")]
+fn the_wave_budget_runs_as_many_waves_as_the_scenes_boxes_allow() {
+    // Nothing is free, so every wave allowed runs: a budget of B boxes × waves in a scene of b
+    // boxes runs max(1, B / b) waves, the same bits as that cap on the first stage.
+    let scene = blocked_scene();
+    let boxes = scene.guide_obstacles().len() as u16;
+    let cfg = three_short_waves();
+    // The Panda prior's own budget (24) would allow more than the three waves here; this
+    // leaves no doubt.
+    const NO_BOUND: Option<u16> = Some(u16::MAX);
+    let mut scratch = Box::new(Scratch::<4>::new());
+    let mut work = Box::new(Workspace::<12>::new());
+    let mut run = |first_stage_waves: u8, wave_budget: Option<u16>| {
+        let mut paths = [[[0.0f32; JOINTS]; HORIZON]; 12];
+        let cfg = PlanConfig {
+            first_stage_waves,
+            wave_budget,
+            ..cfg
+        };
+        denoise(
+            &request(&scene, &cfg),
+            &mut Rng::new(9),
+            &mut scratch,
+            &mut work,
+            &mut paths,
+        )
+        .map(|()| (paths, work.checks.skipped))
+        .unwrap()
+    };
+    assert_eq!(run(u8::MAX, Some(boxes)), run(1, NO_BOUND));
+    assert_eq!(run(u8::MAX, Some(3 * boxes - 1)), run(2, NO_BOUND));
+    assert_eq!(run(u8::MAX, Some(3 * boxes)), run(u8::MAX, NO_BOUND));
+    // At least one wave runs, whatever the budget.
+    assert_eq!(run(u8::MAX, Some(1)), run(1, NO_BOUND));
+    assert_eq!(waves_within(None, 7), usize::MAX);
+    assert_eq!(
+        [12, 16, 17, 24, 25, 100, 0].map(|b| waves_within(Some(48), b)),
+        [4, 3, 2, 2, 1, 1, 48]
+    );
 }
 
 #[test]

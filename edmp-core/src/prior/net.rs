@@ -27,6 +27,11 @@ pub struct Network<const J: usize> {
     pub(crate) net: &'static Net,
     pub(crate) blob: &'static [u8],
     pub(crate) fnv1a: u64,
+    /// The wave budget this prior ships with ([`PlanConfig::wave_budget`](crate::planner::PlanConfig::wave_budget)
+    /// when the config names none): how soon its ensemble hands a scene of many boxes to the
+    /// global stage, measured per arm (docs/benchmark.md, "Bounding the waves"). `None`: every
+    /// wave runs.
+    pub wave_budget: Option<u16>,
 }
 
 impl<const J: usize> core::fmt::Debug for Network<J> {

@@ -20,4 +20,5 @@ pub static NETWORK: Network<JOINTS> = Network {
     net: &NET,
     blob: WEIGHT_BLOB,
     fnv1a: WEIGHTS_FNV1A,
+    wave_budget: Some(crate::planner::WAVE_BUDGET),
 };

@@ -128,6 +128,12 @@ pub struct Tuning {
     /// An experiment in deciding earlier (docs/benchmark.md).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=12))]
     first_stage_waves: Option<u8>,
+    /// A bound on the waves of the first stage and, apart, of the global stage's reseeding, in
+    /// guide boxes × waves: a scene of B boxes runs at most max(1, N / B) of each (0: no
+    /// bound; default: the arm's prior's, 24 for the Panda, none for the others).
+    /// Bounds a plan's guided work on scenes of many boxes (docs/benchmark.md).
+    #[arg(long)]
+    wave_budget: Option<u16>,
     /// Weight of a smoothness term in every guide's step (the bending energy of the path;
     /// 0: EDMP's guides; below 0.125). An ablation (docs/benchmark.md).
     #[arg(long, default_value_t = 0.0)]
@@ -240,6 +246,7 @@ impl Tuning {
             },
             waves: self.waves.unwrap_or(PlanConfig::DEFAULT.waves),
             first_stage_waves: self.first_stage_waves.unwrap_or(PlanConfig::DEFAULT.first_stage_waves),
+            wave_budget: self.wave_budget.map(|n| if n == 0 { u16::MAX } else { n }),
             judging: if self.judge_every {
                 Judging::Every
             } else {
@@ -339,6 +346,11 @@ impl Tuning {
         };
         let boxes = match self.first_stage_waves {
             Some(n) => format!("{boxes}, first stage at most {n} waves"),
+            None => boxes,
+        };
+        let boxes = match self.wave_budget {
+            Some(0) => format!("{boxes}, no wave budget"),
+            Some(n) => format!("{boxes}, wave budget {n} boxes × waves"),
             None => boxes,
         };
         let boxes = if self.no_shortcut {
