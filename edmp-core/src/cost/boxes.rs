@@ -14,7 +14,7 @@ pub struct Aabb {
 
 impl Aabb {
     /// The smallest box holding both.
-    #[inline(always)]
+    #[cfg_attr(not(target_arch = "arm"), inline(always))]
     pub fn union(&self, other: &Self) -> Self {
         Self {
             min: self.min.inf(&other.min),

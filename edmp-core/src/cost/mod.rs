@@ -16,6 +16,10 @@
 //! first), onto that corner as a point moving with its frame ([`Cotangent::add_point`]), and
 //! through [`Kinematics::joint_gradient`]. Waypoints whose boxes touch nothing get an exact
 //! zero without running the adjoint.
+//!
+//! The narrow phase's small functions are inlined by force on the host (the `costs` bench: a
+//! third less time per evaluation); not on a Cortex-M, where the larger loop kept a bounds
+//! check, and so a panic path, that the compiler proves away in the functions apart.
 
 pub mod boxes;
 pub mod clearance;
@@ -114,7 +118,7 @@ impl ObstacleBox {
     }
 
     /// A world point in the frame.
-    #[inline(always)]
+    #[cfg_attr(not(target_arch = "arm"), inline(always))]
     fn local(&self, p: &Vector3<f32>) -> Vector3<f32> {
         match &self.axes {
             Some(a) => a.transpose() * (p - self.origin),
@@ -124,13 +128,13 @@ impl ObstacleBox {
 
     /// Whether a robot box centred at `c` (in the frame) with `|half| = radius` may reach the
     /// box along axis `k`: its AABB's half extent on any axis is at most `radius`.
-    #[inline(always)]
+    #[cfg_attr(not(target_arch = "arm"), inline(always))]
     fn apart_on(&self, c: &Vector3<f32>, radius: f32, k: usize) -> bool {
         c[k] - radius > self.bounds.max[k] || c[k] + radius < self.bounds.min[k]
     }
 
     /// World direction of the frame's axis `k`.
-    #[inline(always)]
+    #[cfg_attr(not(target_arch = "arm"), inline(always))]
     fn axis(&self, k: usize) -> Vector3<f32> {
         // Constant column indices: no run-time bounds check (and no panic path) in nalgebra.
         match (&self.axes, k) {
@@ -180,7 +184,7 @@ impl RobotBox {
     /// The box's AABB in the obstacle's frame given its centre `c` there, with the corners
     /// that set its bounds: along axis `k` the highest corner takes `+half_j` exactly where
     /// `M[k][j] > 0`.
-    #[inline(always)]
+    #[cfg_attr(not(target_arch = "arm"), inline(always))]
     fn aabb_in(&self, o: &ObstacleBox, c: Vector3<f32>) -> (Aabb, [[u8; 3]; 2]) {
         let r = match &o.axes {
             Some(a) => a.transpose() * self.pose.rotation,
@@ -217,7 +221,7 @@ fn held_local_pose(held: &Obstacle) -> Pose<f32> {
 }
 
 /// Intersection volume of `a` with `o` and its gradient with respect to `a`'s bounds.
-#[inline(always)]
+#[cfg_attr(not(target_arch = "arm"), inline(always))]
 fn volume_with_gradient(a: &Aabb, o: &Aabb) -> Option<(f32, Vector3<f32>, Vector3<f32>)> {
     let overlap = a.max.inf(&o.max) - a.min.sup(&o.min);
     if overlap.x <= 0.0 || overlap.y <= 0.0 || overlap.z <= 0.0 {
@@ -320,7 +324,7 @@ impl<const J: usize> Waypoint<J> {
 
 impl Pulls {
     /// Adds the gradient on one bound (axis `k` of the obstacle's frame) to the corner that set it.
-    #[inline(always)]
+    #[cfg_attr(not(target_arch = "arm"), inline(always))]
     fn add(&mut self, slot: usize, corner: u8, o: &ObstacleBox, k: usize, g: f32) {
         let slot = slot % SLOTS;
         if self.touched & (1 << slot) == 0 {
@@ -554,7 +558,7 @@ fn finish<const H: usize, const J: usize>(
 }
 
 /// Whether two boxes overlap with positive volume.
-#[inline(always)]
+#[cfg_attr(not(target_arch = "arm"), inline(always))]
 fn overlaps(a: &Aabb, b: &Aabb) -> bool {
     let (lo, hi) = (a.min.sup(&b.min), a.max.inf(&b.max));
     hi.x > lo.x && hi.y > lo.y && hi.z > lo.z
