@@ -28,15 +28,22 @@ pub const HOST_SEARCH_NODES: usize = 16384;
 /// firmware's work; trees of [`HOST_SEARCH_NODES`] need more iterations to fill.
 pub const HOST_SEARCH_ITERATIONS: u32 = 32_000;
 
+/// Searches the host's global stage tries before it gives up (the core's default and the
+/// firmware's: 4). A search to a narrow passage is a lottery, and searches 5 to 8 run only for
+/// a problem whose first four failed, so they change no other plan; a plan that fails takes
+/// twice as long (docs/robots.md measures both).
+pub const HOST_SEARCH_ATTEMPTS: u8 = 8;
+
 /// The configuration the host plans with (`plan`, `bench`, the Python package): the core's
-/// [`PlanConfig::DEFAULT`] with [`HOST_SEARCH_ITERATIONS`]. `edmp-host embed` plans as the
-/// firmware does, with the core's default.
+/// [`PlanConfig::DEFAULT`] with [`HOST_SEARCH_ITERATIONS`] and [`HOST_SEARCH_ATTEMPTS`].
+/// `edmp-host embed` plans as the firmware does, with the core's default.
 pub const HOST_CONFIG: PlanConfig = PlanConfig {
     global: Some(GlobalConfig {
         search: SearchConfig {
             max_iterations: HOST_SEARCH_ITERATIONS,
             ..SearchConfig::DEFAULT
         },
+        attempts: HOST_SEARCH_ATTEMPTS,
         ..GlobalConfig::DEFAULT
     }),
     ..PlanConfig::DEFAULT

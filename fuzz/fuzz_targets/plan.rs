@@ -8,7 +8,7 @@
 use edmp_core::robot::PANDA;
 use edmp_core::collision::checker::CheckConfig;
 use edmp_core::cost::boxes::{BoxFrame, CylinderBox};
-use edmp_core::planner::GlobalConfig;
+use edmp_core::planner::{GlobalConfig, MAX_ATTEMPTS};
 use edmp_core::guidance::guides::{CLEARANCE_GUIDE, EDMP_GUIDES};
 use edmp_core::planner::{Request, GuidanceSchedule, Judging, PlanConfig, RefineStop, Workspace, plan};
 use edmp_core::prior::{Sampler, Scratch};
@@ -135,10 +135,10 @@ fuzz_target!(|data: &[u8]| {
     if extra & 2 != 0 {
         config.refine_guide = Some(CLEARANCE_GUIDE);
     }
-    // Searches of the global stage, 1-4 (an input that ends before this byte: 1, as before).
+    // Searches of the global stage, 1-8 (an input that ends before this byte: 1, as before).
     // Then whether the search is seeded (an input that ends before it: unseeded, as before).
     if let Some(global) = &mut config.global {
-        global.attempts = 1 + r.byte() % 4;
+        global.attempts = 1 + r.byte() % MAX_ATTEMPTS;
         global.seeded = r.byte() & 1 == 1;
     }
     // Then the refinement's stall stop (an input that ends before it: none, as before).

@@ -238,14 +238,17 @@ pub fn waves_within(budget: Option<u16>, boxes: usize) -> usize {
     budget.map_or(usize::MAX, |budget| (usize::from(budget) / boxes.max(1)).max(1))
 }
 
+/// The most searches [`GlobalConfig::attempts`] allows: a bound on the global stage's work.
+pub const MAX_ATTEMPTS: u8 = 8;
+
 /// Settings of the global stage.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GlobalConfig {
     /// The search's budget, per attempt.
     pub search: SearchConfig,
     /// Searches tried, each from fresh trees and further on the random stream, until one finds
-    /// a path (1 ..= 4). RRT-Connect's work to a narrow passage is a lottery: on the hardest
-    /// unseen problem (window_box/080) one search of the default budget fails for 2-3 seeds in
+    /// a path (1 ..= [`MAX_ATTEMPTS`]). RRT-Connect's work to a narrow passage is a lottery: on
+    /// the hardest unseen problem (window_box/080) one search of the default budget fails for 2-3 seeds in
     /// 16, its trees full before they meet; a second one mostly finds it. Only a problem whose
     /// first search failed pays for another (docs/benchmark.md measures the default).
     pub attempts: u8,
@@ -282,7 +285,7 @@ impl GlobalConfig {
             && usize::from(self.noise_step) <= STEPS
             && self.steps >= 1
             && self.steps <= self.noise_step
-            && (1..=4).contains(&self.attempts);
+            && (1..=MAX_ATTEMPTS).contains(&self.attempts);
         if ok { Ok(()) } else { Err(Error::BadParameter) }
     }
 }

@@ -39,7 +39,7 @@ mod tests;
 
 pub use config::{
     DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GlobalConfig, GuidanceSchedule,
-    Judging, PlanConfig, RefineStop, STALL_RATIO, WAVE_BUDGET, waves_within,
+    Judging, MAX_ATTEMPTS, PlanConfig, RefineStop, STALL_RATIO, WAVE_BUDGET, waves_within,
 };
 pub use first_stage::{denoise, denoise_on};
 pub use judge::{judge, rank_in_full, select};

@@ -296,7 +296,7 @@ fn a_failed_search_is_tried_again_from_fresh_trees_up_to_its_attempts() {
         ..GlobalConfig::DEFAULT
     };
     let run = |global: GlobalConfig| plan_wall_with(&across_the_wall(global));
-    for attempts in 1..=4 {
+    for attempts in 1..=MAX_ATTEMPTS {
         let report = run(global(attempts, 0)).unwrap().search.unwrap();
         assert!(!report.found);
         assert_eq!(
@@ -307,7 +307,7 @@ fn a_failed_search_is_tried_again_from_fresh_trees_up_to_its_attempts() {
     // A search that finds the path is not repeated.
     let found = run(global(4, SearchConfig::DEFAULT.max_iterations)).unwrap();
     assert_eq!(found.search.map(|r| (r.found, r.attempts)), Some((true, 1)));
-    for attempts in [0, 5] {
+    for attempts in [0, MAX_ATTEMPTS + 1] {
         assert_eq!(run(global(attempts, 0)), Err(Error::BadParameter));
     }
 }

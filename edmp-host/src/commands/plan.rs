@@ -7,15 +7,14 @@ use crate::Failure;
 use crate::formats::json::{parse_problem_for, scene_arm};
 use crate::formats::plan::{add_trajectory, plan_document};
 use crate::formats::trajectory::TimedArgs;
-use crate::planning::{HOST_SEARCH_ITERATIONS, chosen_guides, plan_problem_on};
+use crate::planning::{HOST_SEARCH_ATTEMPTS, HOST_SEARCH_ITERATIONS, chosen_guides, plan_problem_on};
 use crate::with_arm;
 use edmp_core::cost::boxes::BoxFrame;
 use edmp_core::guidance::guides::{CLEARANCE_GUIDE, Guide, Schedule};
-use edmp_core::planner::GlobalConfig;
 use edmp_core::planner::search::SearchConfig;
 use edmp_core::planner::{
-    DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GuidanceSchedule, Judging,
-    PlanConfig, RefineStop,
+    DEFAULT_GRADIENT_STEPS, DEFAULT_REFINE_STEPS, DEFAULT_STEP_LIMIT, DEFAULT_STEPS, GlobalConfig, GuidanceSchedule,
+    Judging, MAX_ATTEMPTS, PlanConfig, RefineStop,
 };
 use edmp_core::prior::{Network, Sampler};
 use edmp_core::robot::Robot;
@@ -103,8 +102,8 @@ pub struct Tuning {
     /// and reseeded.
     #[arg(long, default_value_t = SearchConfig::DEFAULT.shortcuts)]
     search_shortcuts: u32,
-    /// Global stage: searches tried, each from fresh trees, until one finds a path (1-4).
-    #[arg(long, default_value_t = GlobalConfig::DEFAULT.attempts, value_parser = clap::value_parser!(u8).range(1..=4))]
+    /// Global stage: searches tried, each from fresh trees, until one finds a path (1-8).
+    #[arg(long, default_value_t = HOST_SEARCH_ATTEMPTS, value_parser = clap::value_parser!(u8).range(1..=i64::from(MAX_ATTEMPTS)))]
     search_attempts: u8,
     /// Global stage: strided denoising steps of the prior from the search's path noised to
     /// step 50 (1-50), each followed by 4 gradient steps of every guide.
@@ -306,7 +305,7 @@ impl Tuning {
             HOST_SEARCH_ITERATIONS,
             SearchConfig::DEFAULT.max_nodes,
             SearchConfig::DEFAULT.shortcuts,
-            GlobalConfig::DEFAULT.attempts,
+            HOST_SEARCH_ATTEMPTS,
         );
         let search = (
             self.search_iterations,
