@@ -248,9 +248,10 @@ pub struct GlobalConfig {
     pub search: SearchConfig,
     /// Searches tried, each from fresh trees and further on the random stream, until one finds
     /// a path (1 ..= [`MAX_ATTEMPTS`]). RRT-Connect's work to a narrow passage is a lottery: on
-    /// the hardest unseen problem (window_box/080) one search of the default budget fails for 2-3 seeds in
-    /// 16, its trees full before they meet; a second one mostly finds it. Only a problem whose
-    /// first search failed pays for another (docs/benchmark.md measures the default).
+    /// the hardest unseen problem (window_box/080) one search of the default budget fails for
+    /// 2-3 seeds in 16, its trees full before they meet; a second one mostly finds it. Only a
+    /// problem whose first search failed pays for another (docs/benchmark.md measures the
+    /// default).
     pub attempts: u8,
     /// Diffusion step the search path is noised to before the prior denoises it (1 ..=
     /// `STEPS`): high enough that the prior reshapes it, low enough that it keeps its route.

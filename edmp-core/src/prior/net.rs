@@ -512,8 +512,7 @@ enum Accumulate {
 }
 
 /// Output positions one tile covers (two AVX registers per channel: eight accumulators, enough
-/// independent sums to hide the adds' latency; 8 positions were 10-15 % slower on a batch of
-/// 12, 24 spilled).
+/// independent sums to hide the adds' latency; 24 positions spill).
 #[cfg(not(target_arch = "arm"))]
 const TILE: usize = 16;
 /// On a Cortex-M's scalar FPU (32 single registers) the 16 accumulators of a 4 × 4 tile fit
