@@ -13,7 +13,8 @@
 //! The `timed` line is the chosen path's time parameterization (`edmp_core::trajectory`, the
 //! spline checked against the scene, the arm's limits, jerk-limited), for free plans (`none`
 //! otherwise). The arm is a build-time choice: the Panda by default, the KUKA iiwa 7 with the
-//! cargo feature `iiwa7` (its own scenes, `scenes/iiwa7/`; `scripts/firmware --robot iiwa7`). `scripts/firmware` compares name, status and fingerprints with the host's plan
+//! cargo feature `iiwa7`, the UFACTORY xArm 6 (six joints) with `xarm6`, each on its own scenes
+//! (`scenes/NAME/`; `scripts/firmware --robot NAME`). `scripts/firmware` compares name, status and fingerprints with the host's plan
 //! and trajectory of the same bytes. Instructions come from SysTick under `-icount shift=0` (calibrated at start against a
 //! loop of known length); stack is the high-water mark of a painted stack. Printing uses no
 //! `core::fmt`, so that the `panic-check` build links only what the planner needs.
@@ -69,8 +70,11 @@ const PIECES: usize = 320;
 /// Tree nodes: as many as any tree over `PIECES` pieces has. 36 bytes each, in `.bss`.
 const NODES: usize = nodes_for(PIECES);
 
+#[cfg(all(feature = "iiwa7", feature = "xarm6"))]
+compile_error!("the firmware plans for one arm: enable at most one of the features `iiwa7` and `xarm6`");
+
 /// The Panda: its tables, its prior and its scenes.
-#[cfg(not(feature = "iiwa7"))]
+#[cfg(not(any(feature = "iiwa7", feature = "xarm6")))]
 mod arm {
     use edmp_core::prior::Network;
     pub use edmp_core::robot::arms::panda::{JOINTS, ROBOT};
@@ -120,6 +124,29 @@ mod arm {
         ("dresser-000", include_bytes!("../scenes/iiwa7/dresser-000.postcard")),
         // An unseen kind: the global stage (search, reseeding) runs.
         ("cage-000", include_bytes!("../scenes/iiwa7/cage-000.postcard")),
+    ];
+}
+
+/// The UFACTORY xArm 6: its tables, its prior and its scenes (from its own suites). Six joints:
+/// every buffer below takes the arm's `JOINTS`.
+#[cfg(feature = "xarm6")]
+mod arm {
+    use edmp_core::prior::Network;
+    pub use edmp_core::robot::arms::xarm6::{JOINTS, ROBOT};
+
+    /// The arm's trained prior (the build stops here if it has none).
+    pub const NETWORK: &Network<JOINTS> = match edmp_core::prior::arms::xarm6::NETWORK {
+        Some(network) => network,
+        None => panic!("the xArm 6 has no trained prior (weights/README.md, \"Another arm\")"),
+    };
+
+    /// The embedded scenes, in `edmp-host embed`'s order (scripts/firmware lists the same files).
+    pub const SCENES: &[(&str, &[u8])] = &[
+        ("tabletop-000", include_bytes!("../scenes/xarm6/tabletop-000.postcard")),
+        ("cubby-000", include_bytes!("../scenes/xarm6/cubby-000.postcard")),
+        ("dresser-000", include_bytes!("../scenes/xarm6/dresser-000.postcard")),
+        // An unseen kind whose first stage collides: the global stage (search, reseeding) runs.
+        ("cage-002", include_bytes!("../scenes/xarm6/cage-002.postcard")),
     ];
 }
 
