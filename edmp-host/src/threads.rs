@@ -44,6 +44,11 @@ impl Threads {
         pools.insert(threads, pool.clone());
         Ok(Self { pool })
     }
+
+    /// Runs `work` inside the pool: rayon's parallel iterators in it use these threads.
+    pub fn install<R: Send>(&self, work: impl FnOnce() -> R + Send) -> R {
+        self.pool.install(work)
+    }
 }
 
 impl Executor for Threads {

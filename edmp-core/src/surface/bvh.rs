@@ -3,6 +3,7 @@
 //! a node's children sit side by side in the node buffer. Median splits along the longest axis
 //! of the centroids keep the depth at about log₂ of the piece count.
 
+use crate::executor::{Executor, MAX_PARTS};
 use crate::surface::element::{Aabb, Element, SurfaceError};
 
 /// A leaf holds at most this many pieces, and a split leaves at least half as many on each
@@ -130,12 +131,141 @@ fn partition(keys: &mut [Key], axis: usize, middle: f32) -> usize {
 /// Each node is split at the middle of its centroids' extent along the longest axis, or at
 /// the median when the middle leaves fewer than an eighth (or two) on one side.
 pub fn split(keys: &mut [Key], nodes: &mut [Node]) -> Result<usize, SurfaceError> {
+    check_buffers(keys, nodes)?;
+    subtree(keys, nodes, Offsets::ROOT)
+}
+
+/// [`split`] with the root's two subtrees built as two items of `exec` (at once on a host's
+/// threads): the same tree, bit for bit, as [`split`] makes.
+pub fn split_on<E: Executor>(exec: &E, keys: &mut [Key], nodes: &mut [Node]) -> Result<usize, SurfaceError> {
+    check_buffers(keys, nodes)?;
+    let count = keys.len();
+    // Below this many keys, or on one thread, the handing over costs more than it saves.
+    if exec.parts() < 2 || count < PARALLEL_FROM || nodes.len() < 3 {
+        return subtree(keys, nodes, Offsets::ROOT);
+    }
+    let mid = divide(keys);
+    let (left_keys, right_keys) = keys.split_at_mut(mid);
+    // `split` numbers the root 0, its children 1 and 2, then the right child's descendants
+    // (the stack's top), then the left child's. Each subtree is built in a region of its own
+    // with local numbers (its root 0), then moved to those places.
+    let right_room = nodes_for(right_keys.len()) - 1;
+    let (head, rest) = nodes.split_at_mut(2);
+    let (right_nodes, left_nodes) = rest.split_at_mut(right_room.min(rest.len()));
+    let mut parts = [
+        Part {
+            keys: left_keys,
+            nodes: left_nodes,
+            at: Offsets { first: 0, depth: 0 },
+            used: Err(SurfaceError::TooFewNodes),
+        },
+        Part {
+            keys: right_keys,
+            nodes: right_nodes,
+            at: Offsets { first: mid, depth: 1 },
+            used: Err(SurfaceError::TooFewNodes),
+        },
+    ];
+    // The task never fails: a subtree's own error travels in its `used` (as does a part an
+    // executor did not run).
+    let _ = exec.each(&mut parts, |part| {
+        part.used = subtree(part.keys, part.nodes, part.at);
+        Ok(())
+    });
+    let [left, right] = parts;
+    let (left_used, right_used) = (left.used?, right.used?);
+    // The right subtree is in place (its root is node 2): its children's numbers move by 2.
+    for node in right.nodes.iter_mut().take(right_used) {
+        if node.left != 0 {
+            node.left += 2;
+        }
+    }
+    // The left subtree's root becomes node 1, its descendants follow the right subtree's.
+    let shift = 1 + right_used as u32;
+    for node in left.nodes.iter_mut().take(left_used) {
+        if node.left != 0 {
+            node.left += shift;
+        }
+    }
+    let left_root = left.nodes.first().copied().unwrap_or(Node::EMPTY);
+    if let [root, left_child] = head {
+        *root = Node {
+            first: 0,
+            count: count as u32,
+            left: 1,
+            ..Node::EMPTY
+        };
+        *left_child = left_root;
+    }
+    let left_start = 2 + right_room;
+    if left_used >= 1 && left_start + left_used <= nodes.len() {
+        nodes.copy_within(left_start + 1..left_start + left_used, 2 + right_used);
+    }
+    Ok(1 + right_used + left_used)
+}
+
+/// Below this many keys [`split_on`] splits on the calling thread.
+const PARALLEL_FROM: usize = 1 << 14;
+
+/// One subtree of [`split_on`]: its keys, the region its nodes are built in, where it stands in
+/// the whole tree, and how many nodes it used.
+struct Part<'a> {
+    keys: &'a mut [Key],
+    nodes: &'a mut [Node],
+    at: Offsets,
+    used: Result<usize, SurfaceError>,
+}
+
+/// Where a subtree stands in the whole tree: the number of its first key, and how deep
+/// [`split`]'s stack already is when it reaches the subtree's root.
+#[derive(Clone, Copy)]
+struct Offsets {
+    first: usize,
+    depth: usize,
+}
+
+impl Offsets {
+    const ROOT: Self = Self { first: 0, depth: 0 };
+}
+
+fn check_buffers(keys: &[Key], nodes: &[Node]) -> Result<(), SurfaceError> {
     if keys.len() > u32::MAX as usize {
         return Err(SurfaceError::TooManyPieces);
     }
     if nodes.len() < nodes_for(keys.len()) {
         return Err(SurfaceError::TooFewNodes);
     }
+    Ok(())
+}
+
+/// Splits `run` in two as the tree does (see [`split`]) and returns the length of the first
+/// part; `run` holds more than [`LEAF`] keys.
+fn divide(run: &mut [Key]) -> usize {
+    let count = run.len();
+    let (clo, chi) = centroid_box(run);
+    let extent: [f32; 3] = core::array::from_fn(|k| chi[k] - clo[k]);
+    let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
+        0
+    } else if extent[1] >= extent[2] {
+        1
+    } else {
+        2
+    };
+    let middle = 0.5 * (clo[axis] + chi[axis]);
+    let mut mid = partition(run, axis, middle);
+    // At least an eighth on each side, and half a leaf: every leaf then holds that
+    // many (so `nodes_for` suffices) and equal centroids cannot chain empty nodes.
+    let least = (count / 8).max(LEAF / 2);
+    if mid < least || mid > count - least {
+        mid = count / 2;
+        run.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
+    }
+    mid
+}
+
+/// [`split`] of the subtree whose keys are `keys`, at `at` in the whole tree, into `nodes`
+/// (its root node 0; `left` and `first` as the whole tree numbers keys, nodes locally).
+fn subtree(keys: &mut [Key], nodes: &mut [Node], at: Offsets) -> Result<usize, SurfaceError> {
     let mut used = 1;
     // Nodes still to split: (node, first, count); a split pushes two, the depth bounds the stack.
     let mut todo = [(0usize, 0usize, 0usize); MAX_DEPTH + 1];
@@ -143,41 +273,27 @@ pub fn split(keys: &mut [Key], nodes: &mut [Node]) -> Result<usize, SurfaceError
     let mut depth = 1;
     while depth > 0 {
         depth -= 1;
-        let (at, first, count) = todo[depth];
+        let (node_at, first, count) = todo[depth];
         let Some(run) = keys.get_mut(first..first + count) else {
             return Err(SurfaceError::TooManyPieces);
         };
         let mut node = Node {
-            first: first as u32,
+            first: (at.first + first) as u32,
             count: count as u32,
             ..Node::EMPTY
         };
-        if count > LEAF && depth + 2 <= MAX_DEPTH && used + 2 <= nodes.len() {
-            let (clo, chi) = centroid_box(run);
-            let extent: [f32; 3] = core::array::from_fn(|k| chi[k] - clo[k]);
-            let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
-                0
-            } else if extent[1] >= extent[2] {
-                1
-            } else {
-                2
-            };
-            let middle = 0.5 * (clo[axis] + chi[axis]);
-            let mut mid = partition(run, axis, middle);
-            // At least an eighth on each side, and half a leaf: every leaf then holds that
-            // many (so `nodes_for` suffices) and equal centroids cannot chain empty nodes.
-            let least = (count / 8).max(LEAF / 2);
-            if mid < least || mid > count - least {
-                mid = count / 2;
-                run.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
-            }
+        if count > LEAF && at.depth + depth + 2 <= MAX_DEPTH && used + 2 <= nodes.len() {
+            let mid = divide(run);
             node.left = used as u32;
-            todo[depth] = (used, first, mid);
-            todo[depth + 1] = (used + 1, first + mid, count - mid);
+            let Some(slots) = todo.get_mut(depth..depth + 2) else {
+                return Err(SurfaceError::TooFewNodes);
+            };
+            slots[0] = (used, first, mid);
+            slots[1] = (used + 1, first + mid, count - mid);
             depth += 2;
             used += 2;
         }
-        if let Some(slot) = nodes.get_mut(at) {
+        if let Some(slot) = nodes.get_mut(node_at) {
             *slot = node;
         }
     }
@@ -187,19 +303,55 @@ pub fn split(keys: &mut [Key], nodes: &mut [Node]) -> Result<usize, SurfaceError
 /// Fills the boxes of the nodes [`split`] wrote, over the pieces in the keys' order. Children
 /// come after their parent: one backward pass fills every box from below.
 pub fn bound(pieces: &[Element], nodes: &mut [Node]) {
+    bound_leaves(pieces, nodes);
+    bound_inner(nodes);
+}
+
+/// [`bound`] with the leaves' boxes (a pass over every piece) filled in parts of the node
+/// buffer, as items of `exec`: the same boxes (a box is a minimum and a maximum, whatever the
+/// order).
+pub fn bound_on<E: Executor>(exec: &E, pieces: &[Element], nodes: &mut [Node]) {
+    let parts = exec.parts().clamp(1, MAX_PARTS);
+    let size = nodes.len().div_ceil(parts).max(1);
+    let mut chunks: [&mut [Node]; MAX_PARTS] = Default::default();
+    for (slot, chunk) in chunks.iter_mut().zip(nodes.chunks_mut(size)) {
+        *slot = chunk;
+    }
+    let parted = exec.each(&mut chunks[..parts], |chunk| {
+        bound_leaves(pieces, chunk);
+        Ok(())
+    });
+    if parted.is_err() {
+        // No task fails; should an executor not run them all, the serial pass does.
+        bound_leaves(pieces, nodes);
+    }
+    bound_inner(nodes);
+}
+
+/// The boxes of the leaves among `nodes` (a leaf's run of `pieces` names its pieces).
+fn bound_leaves(pieces: &[Element], nodes: &mut [Node]) {
+    for node in nodes.iter_mut().filter(|n| n.left == 0) {
+        let end = node.first as usize + node.count as usize;
+        let b = pieces
+            .get(node.first as usize..end)
+            .unwrap_or(&[])
+            .iter()
+            .fold(Aabb::EMPTY, |b, e| b.union(&e.bounds()));
+        node.lo = b.lo.into();
+        node.hi = b.hi.into();
+    }
+}
+
+/// The boxes of the inner nodes, from their children's: children come after their parent, so
+/// one backward pass fills them from below.
+fn bound_inner(nodes: &mut [Node]) {
     for i in (0..nodes.len()).rev() {
         let Some(&node) = nodes.get(i) else { continue };
-        let b = if node.left == 0 {
-            let end = node.first as usize + node.count as usize;
-            pieces
-                .get(node.first as usize..end)
-                .unwrap_or(&[])
-                .iter()
-                .fold(Aabb::EMPTY, |b, e| b.union(&e.bounds()))
-        } else {
-            let child = |k: u32| nodes.get(k as usize).map_or(Aabb::EMPTY, Node::bounds);
-            child(node.left).union(&child(node.left + 1))
-        };
+        if node.left == 0 {
+            continue;
+        }
+        let child = |k: u32| nodes.get(k as usize).map_or(Aabb::EMPTY, Node::bounds);
+        let b = child(node.left).union(&child(node.left + 1));
         if let Some(slot) = nodes.get_mut(i) {
             slot.lo = b.lo.into();
             slot.hi = b.hi.into();
@@ -271,6 +423,50 @@ mod tests {
         }
         assert_eq!(covered, count);
         used
+    }
+
+    #[test]
+    fn split_on_threads_makes_the_same_tree_as_split() {
+        use crate::executor::Reversed;
+        // Surfaces of a few planes (many equal coordinates: the medians' ties), and a blob.
+        for (n, planes) in [(PARALLEL_FROM + 5, true), (40_000, true), (70_001, false)] {
+            let keys: Vec<Key> = (0..n)
+                .map(|i| {
+                    let f = i as f32;
+                    let c = if planes {
+                        [
+                            ((i % 7) as f32) * 0.1,
+                            (i % 113) as f32 * 0.01,
+                            ((i / 113) % 97) as f32 * 0.01,
+                        ]
+                    } else {
+                        [
+                            libm::sinf(f) * 0.5,
+                            libm::cosf(f * 1.3) * 0.4,
+                            libm::sinf(f * 0.7) * 0.3,
+                        ]
+                    };
+                    Key::new(c, i as u32)
+                })
+                .collect();
+            let (mut serial_keys, mut threaded_keys) = (keys.clone(), keys.clone());
+            let mut serial = std::vec![Node::EMPTY; nodes_for(n)];
+            let mut threaded = std::vec![Node::EMPTY; nodes_for(n)];
+            let used = split(&mut serial_keys, &mut serial).unwrap();
+            let used_on = split_on(&Reversed(2), &mut threaded_keys, &mut threaded).unwrap();
+            assert_eq!(used, used_on, "{n} keys");
+            assert_eq!(serial[..used], threaded[..used], "{n} keys");
+            assert_eq!(serial_keys, threaded_keys, "{n} keys");
+            // The boxes too, over balls in the keys' order.
+            let pieces: Vec<Element> = serial_keys
+                .iter()
+                .map(|k| Element::ball(k.centroid(), 0.0075, 0).unwrap())
+                .collect();
+            bound(&pieces, &mut serial[..used]);
+            bound_on(&Reversed(3), &pieces, &mut threaded[..used]);
+            assert_eq!(serial[..used], threaded[..used], "{n} keys");
+            assert!(serial[0].lo[0] < serial[0].hi[0]);
+        }
     }
 
     #[test]

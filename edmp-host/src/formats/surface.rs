@@ -13,10 +13,11 @@ use edmp_core::robot::Robot;
 use edmp_core::robot::kinematics::Joints;
 use edmp_core::scene::{Obstacle, rotation_from_wxyz};
 use edmp_core::surface::Surface;
-use edmp_core::surface::bvh::{Key, Node, bound, nodes_for, split};
-use edmp_core::surface::element::{Element, SurfaceError};
+use edmp_core::surface::bvh::{Key, Node, bound_on, nodes_for, split_on};
+use edmp_core::surface::element::{Element, Piece, SurfaceError};
 use edmp_core::surface::points::{Reduced, reduce};
 use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
 use serde_json::Value;
 use std::path::Path;
 
@@ -418,36 +419,14 @@ pub fn build_surfaces<const J: usize>(
             (Held::Kept(_), SurfaceKind::Mesh { .. }) => Source::Pieces(&[]),
         });
     }
-    // Keys numbered across the sources; pieces then made in the keys' order.
-    let mut firsts = Vec::with_capacity(sources.len());
-    let mut keys = Vec::with_capacity(sources.iter().map(Source::len).sum());
-    for source in &sources {
-        firsts.push(keys.len());
-        for i in 0..source.len() {
-            keys.push(Key::new(source.centroid(i), keys.len() as u32));
-        }
-    }
-    let mut nodes = vec![Node::EMPTY; nodes_for(keys.len())];
-    let used = if keys.is_empty() {
-        0
+    let (pieces, nodes) = if sources.iter().all(|s| s.len() == 0) {
+        (Vec::new(), Vec::new())
     } else {
-        split(&mut keys, &mut nodes).map_err(|e| surface_error(e, "obstacles"))?
+        // The process's pool of two threads, whatever the planner's `--threads` (the one
+        // `--threads 2` plans on): reading a large cloud is mostly this tree.
+        let threads = crate::threads::Threads::new(2).map_err(|e| InputError::at("obstacles", e))?;
+        threads.install(|| tree(&threads, &sources, &obstacles))?
     };
-    nodes.truncate(used);
-    let mut pieces = Vec::with_capacity(keys.len());
-    for key in &keys {
-        let n = key.piece() as usize;
-        let s = firsts.partition_point(|&f| f <= n).saturating_sub(1);
-        let (Some(source), Some(first)) = (sources.get(s), firsts.get(s)) else {
-            continue;
-        };
-        if let Some(made) = source.piece(key, n - first) {
-            let index = obstacles.get(s).map_or(0, |o| o.index);
-            pieces.push(made.map_err(|e| surface_error(e, &format!("obstacles[{index}]")))?);
-        }
-    }
-    drop(keys);
-    bound(&pieces, &mut nodes);
     drop(sources);
     drop(held);
     let closed = obstacles
@@ -472,6 +451,74 @@ pub fn build_surfaces<const J: usize>(
     let made = covers(&surfaces.surface(), &mut boxes);
     surfaces.boxes = boxes[..made].to_vec();
     Ok(surfaces)
+}
+
+/// The pieces of `sources` (one per obstacle of `obstacles`) in the tree's order, and the tree,
+/// made on `threads` (inside its pool): the keys, [`split_on`], the pieces made from the keys,
+/// [`bound_on`]. The same buffers, bit for bit, as on one thread.
+fn tree(
+    threads: &crate::threads::Threads,
+    sources: &[Source<'_>],
+    obstacles: &[SurfaceObstacle],
+) -> Result<(Vec<Element>, Vec<Node>), InputError> {
+    // Keys numbered across the sources; pieces then made in the keys' order.
+    let mut firsts = Vec::with_capacity(sources.len());
+    let mut keys = Vec::with_capacity(sources.iter().map(Source::len).sum());
+    for source in sources {
+        firsts.push(keys.len());
+        let first = keys.len();
+        keys.par_extend(
+            (0..source.len())
+                .into_par_iter()
+                .map(|i| Key::new(source.centroid(i), (first + i) as u32)),
+        );
+    }
+    let mut nodes = vec![Node::EMPTY; nodes_for(keys.len())];
+    let used = if keys.is_empty() {
+        0
+    } else {
+        split_on(threads, &mut keys, &mut nodes).map_err(|e| surface_error(e, "obstacles"))?
+    };
+    nodes.truncate(used);
+    // Made on the pool's threads, in the keys' order. A piece that cannot be made (the sources
+    // were validated: none in practice) stands as its key's ball meanwhile; the first such in
+    // key order is the error.
+    let failed = std::sync::Mutex::new(None::<(u32, usize, SurfaceError)>);
+    let mut pieces = Vec::with_capacity(keys.len());
+    keys.par_iter()
+        .map(|key| {
+            let n = key.piece() as usize;
+            let s = firsts.partition_point(|&f| f <= n).saturating_sub(1);
+            let made = match (sources.get(s), firsts.get(s)) {
+                (Some(source), Some(first)) => source.piece(key, n - first),
+                _ => None,
+            };
+            match made.unwrap_or(Err(SurfaceError::TooManyPieces)) {
+                Ok(piece) => piece,
+                Err(e) => {
+                    if let Ok(mut first) = failed.lock()
+                        && first.is_none_or(|(k, ..)| key.piece() < k)
+                    {
+                        *first = Some((key.piece(), s, e));
+                    }
+                    Element {
+                        piece: Piece::Ball {
+                            center: key.centroid().into(),
+                            radius: 1.0,
+                        },
+                        obstacle: 0,
+                    }
+                }
+            }
+        })
+        .collect_into_vec(&mut pieces);
+    if let Some((_, s, e)) = failed.into_inner().ok().flatten() {
+        let index = obstacles.get(s).map_or(0, |o| o.index);
+        return Err(surface_error(e, &format!("obstacles[{index}]")));
+    }
+    drop(keys);
+    bound_on(threads, &pieces, &mut nodes);
+    Ok((pieces, nodes))
 }
 
 /// Whether a mesh is closed: every edge is shared by exactly two of its (non-degenerate)
