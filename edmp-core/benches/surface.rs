@@ -1,15 +1,18 @@
 //! Building a surface and fitting its guide boxes, for a 200,000-point cloud (issue 33's size:
 //! the host does this once per plan, so it is part of every cloud plan's time). The cloud is
 //! a shelf's surfaces sampled every 4 mm, in shuffled order as a camera's merge leaves it.
-//! Run: `cargo bench -p edmp-core --bench surface`.
+//! The splits alone are timed on one thread and on two (`split_on`, the host's way; the same
+//! tree). Run: `cargo bench -p edmp-core --bench surface`.
 
 use core::hint::black_box;
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use edmp_core::Error;
 use edmp_core::cost::cover::covers;
+use edmp_core::executor::Executor;
 use edmp_core::rng::Rng;
 use edmp_core::scene::Obstacle;
 use edmp_core::surface::Surface;
-use edmp_core::surface::bvh::{Key, Node, build, nodes_for};
+use edmp_core::surface::bvh::{Key, Node, build, nodes_for, split, split_on};
 use edmp_core::surface::element::Element;
 
 /// Points on the faces of a few boards (a shelf's walls and levels), shuffled.
@@ -44,6 +47,24 @@ fn shelf_cloud(count: usize) -> Vec<Element> {
     out
 }
 
+/// Two threads: the first half of the items on a scoped thread, the rest on the caller's.
+struct TwoThreads;
+
+impl Executor for TwoThreads {
+    fn parts(&self) -> usize {
+        2
+    }
+
+    fn each<T: Send, F: Fn(&mut T) -> Result<(), Error> + Sync>(&self, items: &mut [T], task: F) -> Result<(), Error> {
+        let (first, rest) = items.split_at_mut(items.len() / 2);
+        std::thread::scope(|s| {
+            let other = s.spawn(|| first.iter_mut().try_for_each(&task));
+            let here = rest.iter_mut().try_for_each(&task);
+            other.join().unwrap_or(Err(Error::BadParameter)).and(here)
+        })
+    }
+}
+
 fn bench(c: &mut Criterion) {
     const N: usize = 200_000;
     let cloud = shelf_cloud(N);
@@ -52,6 +73,25 @@ fn bench(c: &mut Criterion) {
     let mut keys = vec![Key::EMPTY; N];
     c.bench_function("bvh build, 200k balls", |b| {
         b.iter(|| black_box(build(&cloud, &mut pieces, &mut nodes, &mut keys).ok()))
+    });
+    let fresh: Vec<Key> = cloud
+        .iter()
+        .enumerate()
+        .map(|(i, e)| Key::new(e.centroid().into(), i as u32))
+        .collect();
+    c.bench_function("bvh split, 200k keys, one thread", |b| {
+        b.iter_batched_ref(
+            || fresh.clone(),
+            |keys| black_box(split(keys, &mut nodes).ok()),
+            BatchSize::LargeInput,
+        )
+    });
+    c.bench_function("bvh split_on, 200k keys, two threads", |b| {
+        b.iter_batched_ref(
+            || fresh.clone(),
+            |keys| black_box(split_on(&TwoThreads, keys, &mut nodes).ok()),
+            BatchSize::LargeInput,
+        )
     });
     let used = build(&cloud, &mut pieces, &mut nodes, &mut keys).unwrap_or(0);
     let surface = Surface::new(&pieces, &nodes[..used]).expect("a tree build made");
