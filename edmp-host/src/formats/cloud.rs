@@ -306,6 +306,30 @@ mod tests {
     }
 
     #[test]
+    fn a_large_binary_ply_reads_the_same_on_threads_and_names_a_bad_row() {
+        // Above `ply::ROWS_ON_THREADS` rows the pool reads them; a colour after x, y, z.
+        let rows = 40_000;
+        let point = |i: usize| [i as f32 * 1e-3, -(i as f32), 0.5 + i as f32];
+        let mut body = Vec::new();
+        for i in 0..rows {
+            body.extend(point(i).iter().flat_map(|v| v.to_le_bytes()));
+            body.push(7);
+        }
+        let header = format!(
+            "element vertex {rows}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+        );
+        let points = parse_ply_points(&binary_ply(&header, &body)).unwrap();
+        assert_eq!(points.len(), rows);
+        assert!(points.iter().enumerate().all(|(i, p)| *p == point(i)));
+        // A value that is not finite in a late row: the row and the property are named.
+        let bad = 33_333;
+        let at = bad * 13 + 4;
+        body[at..at + 4].copy_from_slice(&f32::INFINITY.to_le_bytes());
+        let m = message(parse_ply_points(&binary_ply(&header, &body)));
+        assert!(m.contains("row 33333 property \"y\""), "{m}");
+    }
+
+    #[test]
     fn ply_malformed() {
         let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
         let two = [0u8; 24];

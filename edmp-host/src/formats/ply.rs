@@ -9,6 +9,7 @@
 //! where a file is wrong. Format reference: <https://paulbourke.net/dataformats/ply/>.
 
 use super::file_error::{FileError, Where, coordinate, integer, lines, number, show, tokens};
+use rayon::prelude::*;
 
 /// A scalar type of the PLY header.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -214,6 +215,37 @@ fn fixed_rows(element: &Element, xyz: [usize; 3]) -> Option<FixedRows> {
     (stride > 0).then_some(FixedRows { stride, xyz })
 }
 
+/// The little-endian `f32` at `offset` of a row (NaN past its end: refused as not finite).
+fn f32_le_at(chunk: &[u8], offset: usize) -> f32 {
+    chunk
+        .get(offset..offset + 4)
+        .and_then(|b| <[u8; 4]>::try_from(b).ok())
+        .map_or(f32::NAN, f32::from_le_bytes)
+}
+
+/// Below this many rows a cloud is read on the calling thread.
+const ROWS_ON_THREADS: usize = 1 << 15;
+
+/// A large cloud's rows whose x, y and z are `f32` at `offsets`, read on the process's pool of
+/// two threads, in row order; `None` when there are few rows, no pool, or a value that is not
+/// finite (the one-thread loop then reads them and names the row).
+fn f32_rows_on_threads(rows: &[u8], stride: usize, offsets: [usize; 3]) -> Option<Vec<[f32; 3]>> {
+    if rows.len() / stride.max(1) < ROWS_ON_THREADS {
+        return None;
+    }
+    let threads = crate::threads::Threads::new(2).ok()?;
+    threads.install(|| {
+        let mut points = Vec::new();
+        rows.par_chunks_exact(stride)
+            .map(|chunk| offsets.map(|offset| f32_le_at(chunk, offset)))
+            .collect_into_vec(&mut points);
+        points
+            .par_iter()
+            .all(|p| p.iter().all(|v| v.is_finite()))
+            .then_some(points)
+    })
+}
+
 /// The header: the body's encoding, the elements in order, and where the body starts.
 fn header(bytes: &[u8]) -> Result<(bool, Vec<Element>, usize), FileError> {
     let mut ascii = None;
@@ -388,16 +420,16 @@ pub(crate) fn parse(bytes: &[u8], faces: bool) -> Result<PlyData, FileError> {
             let rows = bytes.get(start..start.saturating_add(need)).unwrap_or(&[]);
             // The usual cloud, x, y and z as f32: read as they are (the general path below
             // gives the same values, and the error of a row that is not finite).
-            let f32_at = |chunk: &[u8], offset: usize| {
-                chunk
-                    .get(offset..offset + 4)
-                    .and_then(|b| <[u8; 4]>::try_from(b).ok())
-                    .map_or(f32::NAN, f32::from_le_bytes)
-            };
             let all_f32 = xyz.iter().all(|f| f.scalar == Scalar::F32);
+            if all_f32 && let Some(points) = f32_rows_on_threads(rows, stride, xyz.map(|f| f.offset)) {
+                data.vertices = points;
+                *pos = start + need;
+                have_vertices = true;
+                continue;
+            }
             for (row, chunk) in rows.chunks_exact(stride).enumerate() {
                 if all_f32 {
-                    let point = xyz.map(|f| f32_at(chunk, f.offset));
+                    let point = xyz.map(|f| f32_le_at(chunk, f.offset));
                     if point.iter().all(|v| v.is_finite()) {
                         data.vertices.push(point);
                         continue;
