@@ -465,8 +465,8 @@ fn tree(
     let mut firsts = Vec::with_capacity(sources.len());
     let mut keys = Vec::with_capacity(sources.iter().map(Source::len).sum());
     for source in sources {
-        firsts.push(keys.len());
         let first = keys.len();
+        firsts.push(first);
         keys.par_extend(
             (0..source.len())
                 .into_par_iter()
