@@ -7,8 +7,9 @@
 //! waypoints evenly by joint-space arc length, and smoothed (a few Laplacian passes, each kept
 //! only if the whole trajectory stays free). Deterministic for a seed.
 
+use core::cell::RefCell;
 use core::time::Duration;
-use edmp_core::collision::checker::{CheckConfig, check_end, check_segment, check_trajectory};
+use edmp_core::collision::checker::{CheckConfig, SegmentChecker, check_end, check_trajectory};
 use edmp_core::path::HORIZON;
 use edmp_core::rng::Rng;
 use edmp_core::robot::Robot;
@@ -121,8 +122,9 @@ struct Planner<'a, const J: usize, const N: usize> {
     robot: &'static Robot<f32, J>,
     scene: &'a Scene<'a, N>,
     check: CheckConfig,
-    /// The problem's start and goal: states near them keep the checker's end margin.
-    ends: [[f32; J]; 2],
+    /// Every edge and shortcut, checked by one checker that carries what it learned (the
+    /// core's global stage does the same).
+    edges: RefCell<SegmentChecker<'a, J, N>>,
 }
 
 impl<const J: usize, const N: usize> Planner<'_, J, N> {
@@ -136,8 +138,7 @@ impl<const J: usize, const N: usize> Planner<'_, J, N> {
     }
 
     fn edge_free(&self, a: &[f32; J], b: &[f32; J]) -> Result<bool, RrtError> {
-        let [start, goal] = &self.ends;
-        check_segment(self.robot, self.scene, a, b, [start, goal], &self.check).map_err(RrtError::Checker)
+        self.edges.borrow_mut().free(a, b).map_err(RrtError::Checker)
     }
 
     /// One step of `tree` towards `target`; the new node's index if the edge is free.
@@ -213,11 +214,12 @@ pub(crate) fn plan<const H: usize, const J: usize, const N: usize>(
     seed: u64,
 ) -> Result<RrtPlan<H, J>, RrtError> {
     let began = Instant::now();
+    let check = CheckConfig::default();
     let planner = Planner {
         robot,
         scene,
-        check: CheckConfig::default(),
-        ends: [*start, *goal],
+        check,
+        edges: RefCell::new(SegmentChecker::new(robot, scene, [start, goal], &check).map_err(RrtError::Checker)?),
     };
     if !planner.valid_end(start)? {
         return Err(RrtError::InvalidStart);

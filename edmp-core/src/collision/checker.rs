@@ -89,6 +89,19 @@ impl CheckConfig {
         max_step: MAX_JOINT_STEP,
         self_collision: true,
     };
+
+    /// Every distance finite and at least 0, the step finite and above 0: else
+    /// [`Error::BadParameter`].
+    pub fn validate(&self) -> Result<(), Error> {
+        let distance = |x: f32| x.is_finite() && x >= 0.0;
+        let ok = distance(self.margin)
+            && distance(self.end_margin)
+            && distance(self.end_radius)
+            && distance(self.self_margin)
+            && self.max_step.is_finite()
+            && self.max_step > 0.0;
+        if ok { Ok(()) } else { Err(Error::BadParameter) }
+    }
 }
 
 impl Default for CheckConfig {
@@ -228,6 +241,19 @@ impl<const J: usize> Placed<'_, J> {
         b >= self.robot.bodies.len()
     }
 
+    /// Shape `b`'s box (a robot body's oriented box, which holds its hull; the held object's
+    /// box) proven apart from solid `o`'s by more than the margin along a face normal
+    /// ([`Solid::face_gap`]): the gap, `None` when no face normal proves it.
+    fn boxes_apart(&self, b: usize, o: &Solid) -> Option<f32> {
+        let gap = self.solid(b)?.face_gap(o);
+        (gap > self.margin).then_some(gap)
+    }
+
+    /// Shape `b` as a solid: a robot body's oriented box, or the held object.
+    fn solid(&self, b: usize) -> Option<Solid> {
+        if self.is_held(b) { self.held } else { Some(self.obb(b)) }
+    }
+
     /// Body `b` (robot or held) proven apart from primitive `p`: the certified gap (above the
     /// margin), `None` when it is not proven.
     fn body_apart_from<P: Convex>(&self, b: usize, p: &P, hint: &mut Vector3<f32>) -> Option<f32> {
@@ -261,6 +287,12 @@ impl<const J: usize> Placed<'_, J> {
     /// Bodies `a < b` proven apart: the certified gap, as [`Placed::body_apart_from`].
     fn bodies_apart(&self, a: usize, b: usize, hint: &mut Vector3<f32>) -> Option<f32> {
         let m = self.self_margin;
+        if let (Some(sa), Some(sb)) = (self.solid(a), self.solid(b)) {
+            let gap = sa.face_gap(&sb);
+            if gap > m {
+                return Some(gap);
+            }
+        }
         if self.is_held(b) {
             return match &self.held {
                 Some(h) => apart_by(&self.obb(a), h, m, hint).or_else(|| apart_by(&self.hull(a), h, m, hint)),
@@ -292,17 +324,6 @@ impl<const N: usize> Hints<N> {
             body: [[Vector3::zeros(); SLOTS]; SLOTS],
         }
     }
-}
-
-fn validate(config: &CheckConfig) -> Result<(), Error> {
-    let distance = |x: f32| x.is_finite() && x >= 0.0;
-    let ok = distance(config.margin)
-        && distance(config.end_margin)
-        && distance(config.end_radius)
-        && distance(config.self_margin)
-        && config.max_step.is_finite()
-        && config.max_step > 0.0;
-    if ok { Ok(()) } else { Err(Error::BadParameter) }
 }
 
 const PAIRS: usize = SLOTS * SLOTS;
@@ -373,11 +394,16 @@ struct Prepared<'s, const J: usize, const N: usize> {
     /// Per shape and joint, how far a point of the shape can be from the joint's axis.
     reach: [[f32; J]; SLOTS],
     slack: Slack<J, N>,
+    /// The pair found touching last: tested first at the next state (a search's blocked steps
+    /// mostly touch where the one before did).
+    last: Option<Contact>,
 }
 
 impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
-    fn new(robot: &'static Robot<f32, J>, scene: &'s Scene<'s, N>, config: &CheckConfig) -> Result<Self, Error> {
-        validate(config)?;
+    /// What a check of `scene` needs, for a `config` that passed [`CheckConfig::validate`]. Not a `Result`:
+    /// the firmware's stack would hold the few kilobytes of this twice (the result and the
+    /// value taken out of it).
+    fn new(robot: &'static Robot<f32, J>, scene: &'s Scene<'s, N>, config: &CheckConfig) -> Self {
         let obstacles: [Solid; N] =
             core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Solid::obstacle));
         let obstacle_radius = obstacles.map(|o| o.bounding_radius());
@@ -423,7 +449,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
         let moving = (0..shapes)
             .filter(|&b| moves(robot, b))
             .fold(0u32, |mask, b| mask | 1u32.checked_shl(b as u32).unwrap_or(0));
-        Ok(Self {
+        Self {
             robot,
             scene,
             config: *config,
@@ -437,7 +463,8 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             hints: Hints::new(),
             reach,
             slack: Slack::new(),
-        })
+            last: None,
+        }
     }
 
     /// The first contact at configuration `q`, if any; `margin` is the obstacle clearance
@@ -448,7 +475,19 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
     /// less the largest margin a state may need (`margin` or `end_margin`). Every "free" is
     /// still certified: by a separating direction at this state, or at an earlier one whose
     /// gap the motion since (bounded by [`crate::robot::reach`]) cannot have used up.
+    ///
+    /// The pair that touched at the last contact found is tested first: the contact reported
+    /// may then be another than the walk in order would find first, the verdict is the same.
     fn contact_at(&mut self, q: &[f32; J], margin: f32) -> Result<Option<Contact>, Error> {
+        let found = self.find_contact(q, margin)?;
+        if found.is_some() {
+            self.last = found;
+        }
+        Ok(found)
+    }
+
+    /// [`Prepared::contact_at`] without remembering what it found.
+    fn find_contact(&mut self, q: &[f32; J], margin: f32) -> Result<Option<Contact>, Error> {
         let count = self.scene.obstacles().len();
         let surface = *self.scene.surface();
         let step: [f32; J] = match &self.slack.at {
@@ -498,13 +537,6 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             (false, _, Some(h)) => h.center,
             _ => Vector3::zeros(),
         });
-        // The balls' gap when they are apart by more than `margin`: a lower bound on the
-        // distance between the shapes they hold.
-        let ball_gap = |c1: &Vector3<f32>, r1: f32, c2: &Vector3<f32>, r2: f32, margin: f32| {
-            let d2 = (c1 - c2).norm_squared();
-            let reach = r1 + r2 + margin;
-            (d2 > reach * reach).then(|| sqrt_below(d2) - r1 - r2)
-        };
         let placed = Placed {
             robot,
             k: &k,
@@ -512,6 +544,11 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             margin,
             self_margin,
         };
+        if let Some(contact) = self.last
+            && self.still_touching(contact, &placed, &center, carry, carry_self)
+        {
+            return Ok(Some(contact));
+        }
         for b in (0..self.shapes).filter(|&b| self.moving >> b & 1 == 1) {
             let candidates = self
                 .obstacles
@@ -523,19 +560,15 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
                 if *slack > 0.0 {
                     continue;
                 }
-                let gap = match ball_gap(&center[b % SLOTS], self.radius[b % SLOTS], &o.center, r, margin) {
-                    Some(gap) => gap,
-                    None => match placed.body_apart_from(b, o, hint) {
-                        Some(gap) => gap,
-                        None => {
-                            return Ok(Some(Contact::Obstacle {
-                                body: b as u8,
-                                obstacle: i as u8,
-                            }));
-                        }
-                    },
-                };
-                *slack = gap - carry;
+                match obstacle_gap(&placed, b, (&center[b % SLOTS], self.radius[b % SLOTS]), (o, r), hint) {
+                    Some(gap) => *slack = gap - carry,
+                    None => {
+                        return Ok(Some(Contact::Obstacle {
+                            body: b as u8,
+                            obstacle: i as u8,
+                        }));
+                    }
+                }
             }
             let slack = &mut self.slack.surface[b % SLOTS];
             if !surface.is_empty() && *slack <= 0.0 {
@@ -571,22 +604,108 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             if *slack > 0.0 {
                 continue;
             }
-            let gap = match ball_gap(&center[a], self.radius[a], &center[b], self.radius[b], self_margin) {
-                Some(gap) => gap,
-                None => match placed.bodies_apart(a, b, &mut self.hints.body[a][b]) {
-                    Some(gap) => gap,
-                    None => {
-                        return Ok(Some(Contact::SelfContact {
-                            first: a as u8,
-                            second: b as u8,
-                        }));
-                    }
-                },
-            };
-            *slack = gap - carry_self;
+            match bodies_gap(&placed, [a, b], &center, &self.radius, &mut self.hints.body[a][b]) {
+                Some(gap) => *slack = gap - carry_self,
+                None => {
+                    return Ok(Some(Contact::SelfContact {
+                        first: a as u8,
+                        second: b as u8,
+                    }));
+                }
+            }
         }
         Ok(None)
     }
+
+    /// Whether the pair of `contact` (an obstacle's or a self pair; a surface's is left to the
+    /// walk) still touches at the state `placed`; a pair proven apart takes its gap as slack,
+    /// so the walk in order skips it. A pair with slack left is not tested here.
+    fn still_touching(
+        &mut self,
+        contact: Contact,
+        placed: &Placed<'_, J>,
+        center: &[Vector3<f32>; SLOTS],
+        carry: f32,
+        carry_self: f32,
+    ) -> bool {
+        match contact {
+            Contact::Obstacle { body, obstacle } => {
+                let (b, i) = (usize::from(body) % SLOTS, usize::from(obstacle));
+                let (Some(o), Some(&r), Some(hint), Some(slack)) = (
+                    self.obstacles.get(i),
+                    self.obstacle_radius.get(i),
+                    self.hints.obstacle[b].get_mut(i),
+                    self.slack.obstacle[b].get_mut(i),
+                ) else {
+                    return false;
+                };
+                if *slack > 0.0 {
+                    return false;
+                }
+                match obstacle_gap(placed, b, (&center[b], self.radius[b]), (o, r), hint) {
+                    Some(gap) => {
+                        *slack = gap - carry;
+                        false
+                    }
+                    None => true,
+                }
+            }
+            Contact::SelfContact { first, second } => {
+                let (a, b) = (usize::from(first) % SLOTS, usize::from(second) % SLOTS);
+                let slack = &mut self.slack.body[a][b];
+                if !self.config.self_collision || *slack > 0.0 {
+                    return false;
+                }
+                match bodies_gap(placed, [a, b], center, &self.radius, &mut self.hints.body[a][b]) {
+                    Some(gap) => {
+                        *slack = gap - carry_self;
+                        false
+                    }
+                    None => true,
+                }
+            }
+            Contact::Surface { .. } => false,
+        }
+    }
+}
+
+/// The gap between two balls (centre, radius) when they are apart by more than `margin`: a
+/// lower bound on the distance between the shapes they hold.
+fn ball_gap((c1, r1): (&Vector3<f32>, f32), (c2, r2): (&Vector3<f32>, f32), margin: f32) -> Option<f32> {
+    let d2 = (c1 - c2).norm_squared();
+    let reach = r1 + r2 + margin;
+    (d2 > reach * reach).then(|| sqrt_below(d2) - r1 - r2)
+}
+
+/// Shape `b` (its ball) proven apart from obstacle `o` (its ball) by more than the state's
+/// margin: the certified gap, from the cheapest test that proves it (the balls, the boxes'
+/// face normals, then GJK on the oriented box and the hull); `None` when none does.
+fn obstacle_gap<const J: usize>(
+    placed: &Placed<'_, J>,
+    b: usize,
+    ball: (&Vector3<f32>, f32),
+    (o, r): (&Solid, f32),
+    hint: &mut Vector3<f32>,
+) -> Option<f32> {
+    ball_gap(ball, (&o.center, r), placed.margin)
+        .or_else(|| placed.boxes_apart(b, o))
+        .or_else(|| placed.body_apart_from(b, o, hint))
+}
+
+/// Shapes `a` and `b` proven apart by more than the self margin, as [`obstacle_gap`].
+fn bodies_gap<const J: usize>(
+    placed: &Placed<'_, J>,
+    [a, b]: [usize; 2],
+    center: &[Vector3<f32>; SLOTS],
+    radius: &[f32; SLOTS],
+    hint: &mut Vector3<f32>,
+) -> Option<f32> {
+    ball_gap(
+        (&center[a % SLOTS], radius[a % SLOTS]),
+        (&center[b % SLOTS], radius[b % SLOTS]),
+        placed.self_margin,
+    )
+    .or_else(|| placed.bodies_apart(a, b, hint))
 }
 
 /// Checks one configuration away from the ends: the first contact found, or `None` when
@@ -597,7 +716,8 @@ pub fn check_state<const J: usize, const N: usize>(
     q: &[f32; J],
     config: &CheckConfig,
 ) -> Result<Option<Contact>, Error> {
-    Prepared::new(robot, scene, config)?.contact_at(q, config.margin)
+    config.validate()?;
+    Prepared::new(robot, scene, config).contact_at(q, config.margin)
 }
 
 /// Checks a start or goal as the user gave it: obstacles at `end_margin`, PyBullet's own
@@ -608,7 +728,8 @@ pub fn check_end<const J: usize, const N: usize>(
     q: &[f32; J],
     config: &CheckConfig,
 ) -> Result<Option<Contact>, Error> {
-    Prepared::new(robot, scene, config)?.contact_at(q, config.end_margin)
+    config.validate()?;
+    Prepared::new(robot, scene, config).contact_at(q, config.end_margin)
 }
 
 /// A certified lower bound on the distance from the moving robot bodies' hulls (and the held
@@ -719,11 +840,7 @@ fn check_between_own_ends<const J: usize, const N: usize>(
 /// Checks the straight segment `a → b` (both ends included) of a path whose ends are `ends`
 /// (the problem's start and goal): what a search over the checker asks of each edge.
 ///
-/// The same states as [`check_trajectory`] on `[a, b]`, in another order: `b` first, then
-/// every `COARSE_STRIDE`-th state from `a` on, then the rest. A search's `a` is a node
-/// already known free and its `b` the new step, so an edge that collides mostly does so at
-/// `b`, which one state then proves; a shortcut between two free waypoints collides somewhere
-/// inside, which the coarse pass finds in an eighth of the states.
+/// One segment with nothing carried; [`SegmentChecker`] checks many in turn.
 pub fn check_segment<const J: usize, const N: usize>(
     robot: &'static Robot<f32, J>,
     scene: &Scene<N>,
@@ -732,20 +849,82 @@ pub fn check_segment<const J: usize, const N: usize>(
     ends: [&[f32; J]; 2],
     config: &CheckConfig,
 ) -> Result<bool, Error> {
-    let mut prepared = Prepared::new(robot, scene, config)?;
-    let steps = segment_steps(a, b, config.max_step)?;
-    if prepared.contact_at(b, margin_at(b, ends, config))?.is_some() {
-        return Ok(false);
+    config.validate()?;
+    SegmentChecker::validated(robot, scene, ends, config).free(a, b)
+}
+
+/// Checks straight segments of paths between the same ends one after another, carrying what
+/// each check learned to the next: every pair's slack and separating direction, and the pair
+/// that touched last. A search's edges and a shortener's attempts come back to the same places
+/// of the scene again and again; what is carried only saves tests, the verdicts are
+/// [`check_segment`]'s.
+pub struct SegmentChecker<'s, const J: usize, const N: usize> {
+    prepared: Prepared<'s, J, N>,
+    ends: [[f32; J]; 2],
+}
+
+impl<const J: usize, const N: usize> core::fmt::Debug for SegmentChecker<'_, J, N> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("SegmentChecker")
+            .field("ends", &self.ends)
+            .field("last", &self.prepared.last)
+            .finish_non_exhaustive()
     }
-    let coarse = (0..steps).step_by(COARSE_STRIDE);
-    let fine = (0..steps).filter(|s| s % COARSE_STRIDE as u32 != 0);
-    for step in coarse.chain(fine) {
-        let state = interpolate(a, b, step, steps);
-        if prepared.contact_at(&state, margin_at(&state, ends, config))?.is_some() {
-            return Ok(false);
+}
+
+impl<'s, const J: usize, const N: usize> SegmentChecker<'s, J, N> {
+    /// A checker for `scene` whose paths run between `ends` (the problem's start and goal).
+    pub fn new(
+        robot: &'static Robot<f32, J>,
+        scene: &'s Scene<'s, N>,
+        ends: [&[f32; J]; 2],
+        config: &CheckConfig,
+    ) -> Result<Self, Error> {
+        config.validate()?;
+        Ok(Self::validated(robot, scene, ends, config))
+    }
+
+    /// [`SegmentChecker::new`] for a config known to be valid: a value, not a `Result`, so
+    /// that the caller's frame holds the checker once.
+    pub(crate) fn validated(
+        robot: &'static Robot<f32, J>,
+        scene: &'s Scene<'s, N>,
+        ends: [&[f32; J]; 2],
+        config: &CheckConfig,
+    ) -> Self {
+        Self {
+            prepared: Prepared::new(robot, scene, config),
+            ends: ends.map(|e| *e),
         }
     }
-    Ok(true)
+
+    /// Whether the segment `a → b` is free: the same states as [`check_trajectory`] on
+    /// `[a, b]`, in another order: `b` first, then every `COARSE_STRIDE`-th state from `a` on,
+    /// then the rest. A search's `a` is a node already known free and its `b` the new step, so
+    /// an edge that collides mostly does so at `b`, which one state then proves; a shortcut
+    /// between two free waypoints collides somewhere inside, which the coarse pass finds in an
+    /// eighth of the states.
+    pub fn free(&mut self, a: &[f32; J], b: &[f32; J]) -> Result<bool, Error> {
+        let steps = segment_steps(a, b, self.prepared.config.max_step)?;
+        let [s, g] = &self.ends;
+        let config = self.prepared.config;
+        if self.prepared.contact_at(b, margin_at(b, [s, g], &config))?.is_some() {
+            return Ok(false);
+        }
+        let coarse = (0..steps).step_by(COARSE_STRIDE);
+        let fine = (0..steps).filter(|s| s % COARSE_STRIDE as u32 != 0);
+        for step in coarse.chain(fine) {
+            let state = interpolate(a, b, step, steps);
+            if self
+                .prepared
+                .contact_at(&state, margin_at(&state, [s, g], &config))?
+                .is_some()
+            {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
 }
 
 /// States between the ones [`check_segment`]'s first pass checks (0.08 rad at most apart: close
@@ -775,7 +954,8 @@ fn check_path<const J: usize, const N: usize>(
     stop_at_first: bool,
     first: Option<usize>,
 ) -> Result<TrajectoryReport, Error> {
-    let mut prepared = Prepared::new(robot, scene, config)?;
+    config.validate()?;
+    let mut prepared = Prepared::new(robot, scene, config);
     let mut report = TrajectoryReport {
         states: 0,
         colliding_states: 0,
@@ -1093,6 +1273,47 @@ mod tests {
         assert!(!report.is_free());
         // 2.4 rad at 0.01 rad: 240 steps (241 after f32 rounding of the quotient) plus the end.
         assert!((241..=242).contains(&report.states), "{}", report.states);
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "the exact checker at many states: hours under Miri")]
+    fn a_segment_checker_gives_every_segment_the_verdict_of_a_fresh_check() {
+        // A search's pattern in a drawer-like scene (thin panels, a held object): steps of 0.3
+        // rad from earlier nodes, blocked and free, one after another on one checker.
+        let mut scene = Scene::<8>::new();
+        for (center, dims) in [
+            ([0.55, 0.0, 0.2], [0.4, 0.6, 0.01]),
+            ([0.55, 0.0, 0.5], [0.4, 0.6, 0.01]),
+            ([0.75, 0.0, 0.35], [0.01, 0.6, 0.3]),
+            ([0.55, 0.3, 0.35], [0.4, 0.01, 0.3]),
+            ([0.5, 0.0, -0.02], [1.2, 1.2, 0.02]),
+        ] {
+            scene.push(Obstacle::cuboid(center, dims, ID).unwrap()).unwrap();
+        }
+        scene.hold(Obstacle::cuboid([0.0, 0.0, 0.12], [0.03, 0.03, 0.06], ID).unwrap());
+        let cfg = CheckConfig::default();
+        let ends = [READY, [0.3, 0.2, 0.0, -1.8, 0.0, 2.0, 0.785]];
+        let mut checker = SegmentChecker::new(&PANDA, &scene, [&ends[0], &ends[1]], &cfg).unwrap();
+        let mut rng = crate::rng::Rng::new(3);
+        let mut nodes = [READY; 64];
+        let (mut len, mut free, mut blocked) = (1, 0, 0);
+        for _ in 0..400 {
+            let from = nodes[rng.below(len as u32) as usize];
+            let to: Joints<f32> = core::array::from_fn(|j| {
+                (from[j] + rng.uniform_f32(-0.3, 0.3)).clamp(PANDA.soft_lower[j], PANDA.soft_upper[j])
+            });
+            let carried = checker.free(&from, &to).unwrap();
+            let fresh = check_segment(&PANDA, &scene, &from, &to, [&ends[0], &ends[1]], &cfg).unwrap();
+            assert_eq!(carried, fresh, "{from:?} → {to:?}");
+            if carried {
+                free += 1;
+                nodes[len % 64] = to;
+                len = (len + 1).min(64);
+            } else {
+                blocked += 1;
+            }
+        }
+        assert!(free > 40 && blocked > 40, "{free} free, {blocked} blocked");
     }
 
     #[test]

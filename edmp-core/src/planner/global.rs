@@ -17,15 +17,16 @@
 //! once, when no wave frees one), and one more selection.
 //! [`Plan::stage`] says which stage produced the winner.
 
-use crate::collision::checker::check_segment;
+use crate::collision::checker::SegmentChecker;
 use crate::error::Error;
 use crate::executor::Executor;
 use crate::path::Path;
+use crate::planner::config::GlobalConfig;
 use crate::planner::judge::{judge, rank_in_full, select};
 use crate::planner::plan::{Plan, SearchReport, Stage};
 use crate::planner::refine::{guide_steps, refine};
 use crate::planner::request::Request;
-use crate::planner::search::search_from;
+use crate::planner::search::{SearchOutcome, search_from};
 use crate::planner::waves::in_waves;
 use crate::planner::workspace::{RowChecks, Workspace};
 use crate::prior::{self, Sampler, Scratch, Step};
@@ -45,49 +46,13 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
     plan: &mut Plan<B, J>,
 ) -> Result<(), Error> {
     let Request {
-        scene,
-        start,
-        goal,
-        config,
-        ..
+        start, goal, config, ..
     } = *req;
     let Some(global) = &config.global else {
         return Err(Error::BadParameter);
     };
     global.validate()?;
-    let mut calls = 0u32;
-    let mut edge_free = |a: &Joints<f32, J>, b: &Joints<f32, J>| {
-        calls = calls.saturating_add(1);
-        check_segment(req.robot, scene, a, b, [start, goal], &config.check)
-    };
-    // The first stage's candidate with the lowest swept volume (first on ties): the one that
-    // reaches least into the obstacles.
-    let seed = if global.seeded {
-        let mut best: Option<(f32, &Path<J>)> = None;
-        for (x, v) in plan.paths.iter().zip(&plan.verdicts) {
-            if best.is_none_or(|(swept, _)| v.swept < swept) {
-                best = Some((v.swept, x));
-            }
-        }
-        best.map_or(&[][..], |(_, x)| &x[..])
-    } else {
-        &[]
-    };
-    let mut found = None;
-    let mut attempts = 0u8;
-    while found.is_none() && attempts < global.attempts {
-        attempts += 1;
-        found = search_from(
-            req.robot,
-            start,
-            goal,
-            seed,
-            &global.search,
-            &mut work.search,
-            rng,
-            &mut edge_free,
-        )?;
-    }
+    let (found, attempts, calls) = search_with_one_checker(req, global, rng, work, plan)?;
     let report = |found: bool, nodes: usize, iterations: u32| SearchReport {
         found,
         nodes: nodes as u32,
@@ -158,4 +123,55 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
     }
     plan.stage = Stage::Search;
     Ok(())
+}
+
+/// The searches of the global stage, up to `attempts`, over one [`SegmentChecker`]: the path
+/// found (if any), the searches run and the segments checked. Not inlined, so that the
+/// checker's memory (a few kilobytes per obstacle slot) is off the stack before the prior
+/// reshapes the path: the firmware's peak stack is the reseeding's.
+#[inline(never)]
+fn search_with_one_checker<const B: usize, const N: usize, const CAP: usize, const J: usize>(
+    req: &Request<'_, N, J>,
+    global: &GlobalConfig,
+    rng: &mut Rng,
+    work: &mut Workspace<B, CAP, J>,
+    plan: &Plan<B, J>,
+) -> Result<(Option<SearchOutcome<J>>, u8, u32), Error> {
+    let (scene, [start, goal], check) = (req.scene, [req.start, req.goal], &req.config.check);
+    let mut calls = 0u32;
+    check.validate()?;
+    let mut checker = SegmentChecker::validated(req.robot, scene, [start, goal], check);
+    let mut edge_free = |a: &Joints<f32, J>, b: &Joints<f32, J>| {
+        calls = calls.saturating_add(1);
+        checker.free(a, b)
+    };
+    // The first stage's candidate with the lowest swept volume (first on ties): the one that
+    // reaches least into the obstacles.
+    let seed = if global.seeded {
+        let mut best: Option<(f32, &Path<J>)> = None;
+        for (x, v) in plan.paths.iter().zip(&plan.verdicts) {
+            if best.is_none_or(|(swept, _)| v.swept < swept) {
+                best = Some((v.swept, x));
+            }
+        }
+        best.map_or(&[][..], |(_, x)| &x[..])
+    } else {
+        &[]
+    };
+    let mut found = None;
+    let mut attempts = 0u8;
+    while found.is_none() && attempts < global.attempts {
+        attempts += 1;
+        found = search_from(
+            req.robot,
+            start,
+            goal,
+            seed,
+            &global.search,
+            &mut work.search,
+            rng,
+            &mut edge_free,
+        )?;
+    }
+    Ok((found, attempts, calls))
 }

@@ -24,7 +24,7 @@
     clippy::arithmetic_side_effects
 )]
 
-use crate::collision::checker::{CheckConfig, check_segment, check_trajectory};
+use crate::collision::checker::{CheckConfig, SegmentChecker, check_trajectory};
 use crate::error::Error;
 use crate::path::{HORIZON, Path};
 use crate::planner::search::{resample_even, resample_through_vertices, segment_length, shortcut_polyline};
@@ -95,13 +95,7 @@ pub fn shorten<const N: usize, const J: usize>(
     };
     let free = |p: &Path<J>| -> Result<bool, Error> { Ok(check_trajectory(robot, scene, p, check, true)?.is_free()) };
     let mut polyline = *path;
-    let mut edge_free =
-        |a: &Joints<f32, J>, b: &Joints<f32, J>| check_segment(robot, scene, a, b, [start, goal], check);
-    let n = greedy(&mut polyline, config.greedy_checks, &mut edge_free)?;
-    let (n, _) = match polyline.get_mut(..n) {
-        Some(kept) => shortcut_polyline(kept, config.attempts, rng, &mut edge_free)?,
-        None => (n, 0),
-    };
+    let n = shortcut_edges(robot, scene, [start, goal], check, config, rng, &mut polyline)?;
     let Some(corners) = polyline.get(..n) else {
         return Ok(report);
     };
@@ -149,6 +143,29 @@ pub fn shorten<const N: usize, const J: usize>(
     }
     report.length_after = length(path);
     Ok(report)
+}
+
+/// The greedy joins, then the random shortcuts, of `polyline` (in place) over one
+/// [`SegmentChecker`]: the number of waypoints kept. Not inlined, so that the checker's memory
+/// is off the stack before the smoothing's checks.
+#[inline(never)]
+fn shortcut_edges<const N: usize, const J: usize>(
+    robot: &'static Robot<f32, J>,
+    scene: &Scene<N>,
+    ends: [&Joints<f32, J>; 2],
+    check: &CheckConfig,
+    config: &ShortcutConfig,
+    rng: &mut Rng,
+    polyline: &mut Path<J>,
+) -> Result<usize, Error> {
+    check.validate()?;
+    let mut checker = SegmentChecker::validated(robot, scene, ends, check);
+    let mut edge_free = |a: &Joints<f32, J>, b: &Joints<f32, J>| checker.free(a, b);
+    let n = greedy(polyline, config.greedy_checks, &mut edge_free)?;
+    Ok(match polyline.get_mut(..n) {
+        Some(kept) => shortcut_polyline(kept, config.attempts, rng, &mut edge_free)?.0,
+        None => n,
+    })
 }
 
 /// Joins each kept waypoint of `path` to the farthest later waypoint it sees (bisection over
@@ -218,6 +235,7 @@ fn length<const J: usize>(path: &Path<J>) -> f32 {
 )]
 mod tests {
     use super::*;
+    use crate::collision::checker::check_segment;
     use crate::robot::PANDA;
     use crate::scene::Obstacle;
 
