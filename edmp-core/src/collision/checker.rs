@@ -354,8 +354,20 @@ const CARRY_SLACK: f32 = 1e-4;
 /// shapes may still move, together, before the gap last certified for it no longer proves the
 /// margin. A pair with slack left at a state is free there without a test, and a state all of
 /// whose pairs have slack left needs no kinematics.
+///
+/// A shape's obstacle pairs share its motion, so their slack is kept as the motion total at
+/// which it runs out: a state adds the shape's motion to one total (`used`) instead of
+/// subtracting it from every pair, and a shape whose total stays below the least of its pairs'
+/// (`obstacle_least`) skips them all. A scene of many obstacles far from most links is then
+/// a few comparisons per state.
 struct Slack<const J: usize, const N: usize> {
+    /// Per shape and obstacle: the shape's `used` at which the pair's slack runs out.
     obstacle: [[f32; N]; SLOTS],
+    /// Per shape, at most the least of its `obstacle` entries.
+    obstacle_least: [f32; SLOTS],
+    /// Per shape, how far it may have moved since its entries were last rebased (kept below
+    /// [`REBASE`], where f32 resolves fractions of a micrometre).
+    used: [f32; SLOTS],
     /// Per shape, against the whole surface (its nearest piece).
     surface: [f32; SLOTS],
     body: [[f32; SLOTS]; SLOTS],
@@ -363,14 +375,36 @@ struct Slack<const J: usize, const N: usize> {
     at: Option<[f32; J]>,
 }
 
+/// How far a shape's motion total may grow before its obstacle entries are rebased to it
+/// (metres).
+const REBASE: f32 = 1.0;
+
 impl<const J: usize, const N: usize> Slack<J, N> {
     fn new() -> Self {
         Self {
             obstacle: [[0.0; N]; SLOTS],
+            obstacle_least: [0.0; SLOTS],
+            used: [0.0; SLOTS],
             surface: [0.0; SLOTS],
             body: [[0.0; SLOTS]; SLOTS],
             at: None,
         }
+    }
+
+    /// Shape `b` moved by `moved`: whether any of its obstacle pairs may need a test.
+    fn use_obstacles(&mut self, b: usize, moved: f32, count: usize) -> bool {
+        let b = b % SLOTS;
+        let used = &mut self.used[b];
+        *used += moved;
+        if *used > REBASE {
+            let base = *used;
+            for e in self.obstacle[b].iter_mut().take(count) {
+                *e -= base;
+            }
+            self.obstacle_least[b] -= base;
+            *used = 0.0;
+        }
+        self.obstacle_least[b].partial_cmp(used) != Some(Ordering::Greater)
     }
 }
 
@@ -502,10 +536,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
         let mut untested = false;
         let robot = self.robot;
         for b in (0..self.shapes).filter(|&b| self.moving >> b & 1 == 1) {
-            for s in self.slack.obstacle[b % SLOTS].iter_mut().take(count) {
-                *s -= moved[b % SLOTS];
-                untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
-            }
+            untested |= self.slack.use_obstacles(b, moved[b % SLOTS], count);
             if !surface.is_empty() {
                 let s = &mut self.slack.surface[b % SLOTS];
                 *s -= moved[b % SLOTS];
@@ -550,25 +581,30 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             return Ok(Some(contact));
         }
         for b in (0..self.shapes).filter(|&b| self.moving >> b & 1 == 1) {
-            let candidates = self
-                .obstacles
-                .iter()
-                .zip(self.obstacle_radius.iter())
-                .zip(self.hints.obstacle[b % SLOTS].iter_mut())
-                .zip(self.slack.obstacle[b % SLOTS].iter_mut());
-            for (i, (((o, &r), hint), slack)) in candidates.take(count).enumerate() {
-                if *slack > 0.0 {
-                    continue;
-                }
-                match obstacle_gap(&placed, b, (&center[b % SLOTS], self.radius[b % SLOTS]), (o, r), hint) {
-                    Some(gap) => *slack = gap - carry,
-                    None => {
-                        return Ok(Some(Contact::Obstacle {
-                            body: b as u8,
-                            obstacle: i as u8,
-                        }));
+            let used = self.slack.used[b % SLOTS];
+            if self.slack.obstacle_least[b % SLOTS].partial_cmp(&used) != Some(Ordering::Greater) {
+                let candidates = self
+                    .obstacles
+                    .iter()
+                    .zip(self.obstacle_radius.iter())
+                    .zip(self.hints.obstacle[b % SLOTS].iter_mut())
+                    .zip(self.slack.obstacle[b % SLOTS].iter_mut());
+                let ball = (&center[b % SLOTS], self.radius[b % SLOTS]);
+                for (i, (((o, &r), hint), runs_out)) in candidates.take(count).enumerate() {
+                    if *runs_out > used {
+                        continue;
+                    }
+                    match obstacle_gap(&placed, b, ball, (o, r), hint) {
+                        Some(gap) => *runs_out = used + (gap - carry),
+                        None => {
+                            return Ok(Some(Contact::Obstacle {
+                                body: b as u8,
+                                obstacle: i as u8,
+                            }));
+                        }
                     }
                 }
+                self.slack.obstacle_least[b % SLOTS] = least(self.slack.obstacle[b % SLOTS].iter().take(count));
             }
             let slack = &mut self.slack.surface[b % SLOTS];
             if !surface.is_empty() && *slack <= 0.0 {
@@ -631,7 +667,8 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
         match contact {
             Contact::Obstacle { body, obstacle } => {
                 let (b, i) = (usize::from(body) % SLOTS, usize::from(obstacle));
-                let (Some(o), Some(&r), Some(hint), Some(slack)) = (
+                let used = self.slack.used[b];
+                let (Some(o), Some(&r), Some(hint), Some(runs_out)) = (
                     self.obstacles.get(i),
                     self.obstacle_radius.get(i),
                     self.hints.obstacle[b].get_mut(i),
@@ -639,12 +676,13 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
                 ) else {
                     return false;
                 };
-                if *slack > 0.0 {
+                if *runs_out > used {
                     return false;
                 }
                 match obstacle_gap(placed, b, (&center[b], self.radius[b]), (o, r), hint) {
+                    // Raised from at most `used`: `obstacle_least` still bounds it from below.
                     Some(gap) => {
-                        *slack = gap - carry;
+                        *runs_out = used + (gap - carry);
                         false
                     }
                     None => true,
@@ -669,8 +707,23 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
     }
 }
 
+/// The least of `values`, a NaN counting as minus infinity (a pair never skipped); infinity
+/// for none.
+fn least<'v>(values: impl Iterator<Item = &'v f32>) -> f32 {
+    values.fold(f32::INFINITY, |m, &v| {
+        if v >= m {
+            m
+        } else if v < m {
+            v
+        } else {
+            f32::NEG_INFINITY
+        }
+    })
+}
+
 /// The gap between two balls (centre, radius) when they are apart by more than `margin`: a
 /// lower bound on the distance between the shapes they hold.
+#[inline(always)]
 fn ball_gap((c1, r1): (&Vector3<f32>, f32), (c2, r2): (&Vector3<f32>, f32), margin: f32) -> Option<f32> {
     let d2 = (c1 - c2).norm_squared();
     let reach = r1 + r2 + margin;
@@ -680,6 +733,7 @@ fn ball_gap((c1, r1): (&Vector3<f32>, f32), (c2, r2): (&Vector3<f32>, f32), marg
 /// Shape `b` (its ball) proven apart from obstacle `o` (its ball) by more than the state's
 /// margin: the certified gap, from the cheapest test that proves it (the balls, the boxes'
 /// face normals, then GJK on the oriented box and the hull); `None` when none does.
+#[inline(always)]
 fn obstacle_gap<const J: usize>(
     placed: &Placed<'_, J>,
     b: usize,
