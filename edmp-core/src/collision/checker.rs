@@ -305,6 +305,14 @@ impl<const J: usize> Placed<'_, J> {
 
 /// Robot shapes per state, at most: every collision body, then the held object.
 const SLOTS: usize = MAX_BODIES + 1;
+
+/// Shape index `i` as an index into the per-shape arrays: `i` itself, which is always below
+/// [`SLOTS`]; the `min` proves that to the compiler (no panic path) for a compare, where
+/// `% SLOTS` (not a power of two) cost a division in the checker's hottest loops.
+#[inline(always)]
+fn slot(i: usize) -> usize {
+    i.min(SLOTS - 1)
+}
 const _: () = assert!(SLOTS <= u32::BITS as usize, "one bit per shape in `Prepared::moving`");
 
 /// The separating direction last found for each pair, carried from one state of a trajectory
@@ -329,16 +337,28 @@ impl<const N: usize> Hints<N> {
 const PAIRS: usize = SLOTS * SLOTS;
 
 /// How far two shapes can move relative to each other for joint steps `step`: a joint that
-/// turns both turns them together and changes nothing between them; one that turns only one
-/// moves it by its reach ([`crate::robot::reach`]).
-fn relative_motion<const J: usize>(a: &[f32; J], b: &[f32; J], step: &[f32; J]) -> f32 {
+/// turns both (bit `j` of `shared`, [`joints_turning_both`]) turns them together and changes
+/// nothing between them; one that turns only one moves it by its reach
+/// ([`crate::robot::reach`]). Branch-free over the joints: a shared joint adds an exact zero.
+fn relative_motion<const J: usize>(a: &[f32; J], b: &[f32; J], shared: u32, step: &[f32; J]) -> f32 {
     let mut m = 0.0f32;
-    for ((ra, rb), d) in a.iter().zip(b).zip(step) {
-        if !(*ra > 0.0 && *rb > 0.0) {
-            m += (ra + rb) * d;
-        }
+    for (j, ((ra, rb), d)) in a.iter().zip(b).zip(step).enumerate() {
+        let both = shared.checked_shr(j as u32).unwrap_or(0) & 1 == 1;
+        m += if both { 0.0 } else { (ra + rb) * d };
     }
     m
+}
+
+/// Bit `j` set when joint `j` turns both shapes of reaches `a` and `b` (joints past the 32nd
+/// count as turning one only: more motion, never less).
+fn joints_turning_both<const J: usize>(a: &[f32; J], b: &[f32; J]) -> u32 {
+    a.iter().zip(b).enumerate().fold(0u32, |mask, (j, (ra, rb))| {
+        if *ra > 0.0 && *rb > 0.0 {
+            mask | 1u32.checked_shl(j as u32).unwrap_or(0)
+        } else {
+            mask
+        }
+    })
 }
 
 /// How far the surface's pieces are looked for around a body: nearer pieces are proven clear
@@ -393,7 +413,7 @@ impl<const J: usize, const N: usize> Slack<J, N> {
 
     /// Shape `b` moved by `moved`: whether any of its obstacle pairs may need a test.
     fn use_obstacles(&mut self, b: usize, moved: f32, count: usize) -> bool {
-        let b = b % SLOTS;
+        let b = slot(b);
         let used = &mut self.used[b];
         *used += moved;
         if *used > REBASE {
@@ -424,6 +444,8 @@ struct Prepared<'s, const J: usize, const N: usize> {
     radius: [f32; SLOTS],
     pairs: [(u8, u8); PAIRS],
     pair_count: usize,
+    /// Per pair, the joints that turn both its shapes ([`joints_turning_both`]).
+    shared: [u32; PAIRS],
     hints: Hints<N>,
     /// Per shape and joint, how far a point of the shape can be from the joint's axis.
     reach: [[f32; J]; SLOTS],
@@ -480,6 +502,12 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
                 push((a as u8, bodies as u8));
             }
         }
+        let shared = core::array::from_fn(|p| match pairs.get(p) {
+            Some(&(a, b)) if p < pair_count => {
+                joints_turning_both(&reach[slot(usize::from(a))], &reach[slot(usize::from(b))])
+            }
+            _ => 0,
+        });
         let moving = (0..shapes)
             .filter(|&b| moves(robot, b))
             .fold(0u32, |mask, b| mask | 1u32.checked_shl(b as u32).unwrap_or(0));
@@ -494,6 +522,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             radius,
             pairs,
             pair_count,
+            shared,
             hints: Hints::new(),
             reach,
             slack: Slack::new(),
@@ -536,18 +565,18 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
         let mut untested = false;
         let robot = self.robot;
         for b in (0..self.shapes).filter(|&b| self.moving >> b & 1 == 1) {
-            untested |= self.slack.use_obstacles(b, moved[b % SLOTS], count);
+            untested |= self.slack.use_obstacles(b, moved[slot(b)], count);
             if !surface.is_empty() {
-                let s = &mut self.slack.surface[b % SLOTS];
-                *s -= moved[b % SLOTS];
+                let s = &mut self.slack.surface[slot(b)];
+                *s -= moved[slot(b)];
                 untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
             }
         }
         if self.config.self_collision {
-            for &(a, b) in self.pairs.iter().take(self.pair_count) {
-                let (a, b) = (usize::from(a) % SLOTS, usize::from(b) % SLOTS);
+            for (&(a, b), &shared) in self.pairs.iter().zip(&self.shared).take(self.pair_count) {
+                let (a, b) = (slot(usize::from(a)), slot(usize::from(b)));
                 let s = &mut self.slack.body[a][b];
-                *s -= relative_motion(&self.reach[a], &self.reach[b], &step);
+                *s -= relative_motion(&self.reach[a], &self.reach[b], shared, &step);
                 untested |= (*s).partial_cmp(&0.0) != Some(Ordering::Greater);
             }
         }
@@ -581,15 +610,15 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             return Ok(Some(contact));
         }
         for b in (0..self.shapes).filter(|&b| self.moving >> b & 1 == 1) {
-            let used = self.slack.used[b % SLOTS];
-            if self.slack.obstacle_least[b % SLOTS].partial_cmp(&used) != Some(Ordering::Greater) {
+            let used = self.slack.used[slot(b)];
+            if self.slack.obstacle_least[slot(b)].partial_cmp(&used) != Some(Ordering::Greater) {
                 let candidates = self
                     .obstacles
                     .iter()
                     .zip(self.obstacle_radius.iter())
-                    .zip(self.hints.obstacle[b % SLOTS].iter_mut())
-                    .zip(self.slack.obstacle[b % SLOTS].iter_mut());
-                let ball = (&center[b % SLOTS], self.radius[b % SLOTS]);
+                    .zip(self.hints.obstacle[slot(b)].iter_mut())
+                    .zip(self.slack.obstacle[slot(b)].iter_mut());
+                let ball = (&center[slot(b)], self.radius[slot(b)]);
                 for (i, (((o, &r), hint), runs_out)) in candidates.take(count).enumerate() {
                     if *runs_out > used {
                         continue;
@@ -604,14 +633,14 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
                         }
                     }
                 }
-                self.slack.obstacle_least[b % SLOTS] = least(self.slack.obstacle[b % SLOTS].iter().take(count));
+                self.slack.obstacle_least[slot(b)] = least(self.slack.obstacle[slot(b)].iter().take(count));
             }
-            let slack = &mut self.slack.surface[b % SLOTS];
+            let slack = &mut self.slack.surface[slot(b)];
             if !surface.is_empty() && *slack <= 0.0 {
-                let hint = &mut self.hints.surface[b % SLOTS];
+                let hint = &mut self.hints.surface[slot(b)];
                 let around = match (robot.bodies.get(b), k.boxes.get(b)) {
                     (Some(body), Some(pose)) => Aabb::around_box(&pose.translation, &pose.rotation, &body.half_extents),
-                    _ => Aabb::around_ball(&center[b % SLOTS], self.radius[b % SLOTS]),
+                    _ => Aabb::around_ball(&center[slot(b)], self.radius[slot(b)]),
                 };
                 let gap = surface.gap(&around, margin, SURFACE_HORIZON, |probe| match probe {
                     Probe::Piece(e) => placed
@@ -634,8 +663,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
             return Ok(None);
         }
         for &(a, b) in self.pairs.iter().take(self.pair_count) {
-            // `% SLOTS`: pairs hold shape indices below SLOTS; the modulo proves it to the compiler.
-            let (a, b) = (usize::from(a) % SLOTS, usize::from(b) % SLOTS);
+            let (a, b) = (slot(usize::from(a)), slot(usize::from(b)));
             let slack = &mut self.slack.body[a][b];
             if *slack > 0.0 {
                 continue;
@@ -666,7 +694,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
     ) -> bool {
         match contact {
             Contact::Obstacle { body, obstacle } => {
-                let (b, i) = (usize::from(body) % SLOTS, usize::from(obstacle));
+                let (b, i) = (slot(usize::from(body)), usize::from(obstacle));
                 let used = self.slack.used[b];
                 let (Some(o), Some(&r), Some(hint), Some(runs_out)) = (
                     self.obstacles.get(i),
@@ -689,7 +717,7 @@ impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
                 }
             }
             Contact::SelfContact { first, second } => {
-                let (a, b) = (usize::from(first) % SLOTS, usize::from(second) % SLOTS);
+                let (a, b) = (slot(usize::from(first)), slot(usize::from(second)));
                 let slack = &mut self.slack.body[a][b];
                 if !self.config.self_collision || *slack > 0.0 {
                     return false;
@@ -755,8 +783,8 @@ fn bodies_gap<const J: usize>(
     hint: &mut Vector3<f32>,
 ) -> Option<f32> {
     ball_gap(
-        (&center[a % SLOTS], radius[a % SLOTS]),
-        (&center[b % SLOTS], radius[b % SLOTS]),
+        (&center[slot(a)], radius[slot(a)]),
+        (&center[slot(b)], radius[slot(b)]),
         placed.self_margin,
     )
     .or_else(|| placed.bodies_apart(a, b, hint))
