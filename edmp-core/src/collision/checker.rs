@@ -456,9 +456,9 @@ struct Prepared<'s, const J: usize, const N: usize> {
 }
 
 impl<'s, const J: usize, const N: usize> Prepared<'s, J, N> {
-    /// What a check of `scene` needs, for a `config` that passed [`CheckConfig::validate`]. Not a `Result`:
-    /// the firmware's stack would hold the few kilobytes of this twice (the result and the
-    /// value taken out of it).
+    /// What a check of `scene` needs, for a `config` that passed [`CheckConfig::validate`].
+    /// Not a `Result`: the firmware's stack would hold the few kilobytes of this twice (the
+    /// result and the value taken out of it).
     fn new(robot: &'static Robot<f32, J>, scene: &'s Scene<'s, N>, config: &CheckConfig) -> Self {
         let obstacles: [Solid; N] =
             core::array::from_fn(|i| scene.obstacles().get(i).map_or(PLACEHOLDER, Solid::obstacle));
