@@ -127,8 +127,8 @@ pub fn rescue<E: Executor, const B: usize, const N: usize, const C: usize, const
 
 /// The searches of the global stage, up to `attempts`, over one [`SegmentChecker`]: the path
 /// found (if any), the searches run and the segments checked. Not inlined, so that the
-/// checker's memory (a few kilobytes per obstacle slot) is off the stack before the prior
-/// reshapes the path: the firmware's peak stack is the reseeding's.
+/// checker's memory (per obstacle slot and robot shape a slack and a separating direction:
+/// kilobytes) is off the stack before the prior reshapes the path.
 #[inline(never)]
 fn search_with_one_checker<const B: usize, const N: usize, const CAP: usize, const J: usize>(
     req: &Request<'_, N, J>,
