@@ -6,6 +6,7 @@
 
 use crate::arms::{LimitSource, PairRule};
 use crate::math::{self, Mat3, Vec3};
+use crate::mesh;
 use crate::urdf::{Chain, FINGER_OPENING, Motion};
 use core::fmt::Write;
 
@@ -90,6 +91,48 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         "/// Number of collision-mesh vertices kept for the exact checker (all bodies).",
     );
     wl(w, &format!("pub const HULL_POINTS: usize = {hull_total};"));
+    let graphs: Vec<_> = chain.bodies.iter().map(|b| mesh::hull_graph(&b.points)).collect();
+    let mut starts = vec![0usize];
+    let mut neighbours = Vec::new();
+    for (b, graph) in chain.bodies.iter().zip(&graphs) {
+        for i in 0..b.points.len() {
+            if let Some((lists, _)) = graph {
+                neighbours.extend(lists[i].iter().map(|n| n.to_string()));
+            }
+            starts.push(neighbours.len());
+        }
+    }
+    assert!(
+        neighbours.len() <= usize::from(u16::MAX),
+        "{} hull edges ends do not fit the u16 offsets of HULL_EDGE_START",
+        neighbours.len()
+    );
+    wl(
+        w,
+        "/// Where the neighbours of each hull vertex (all bodies' vertices in `hull_points` order, then\n\
+         /// one past the end) begin in `HULL_NEIGHBOURS`.",
+    );
+    let starts: Vec<_> = starts.iter().map(usize::to_string).collect();
+    wl(
+        w,
+        &format!(
+            "pub static HULL_EDGE_START: [u16; HULL_POINTS + 1] = [{}];",
+            starts.join(", ")
+        ),
+    );
+    wl(
+        w,
+        "/// Each hull vertex's neighbours along its hull's edges, ascending, as indices into its body's\n\
+         /// vertices (the hulls' triangles, computed in f64 at build time).",
+    );
+    wl(
+        w,
+        &format!(
+            "pub static HULL_NEIGHBOURS: [u16; {}] = [{}];",
+            neighbours.len(),
+            neighbours.join(", ")
+        ),
+    );
     wl(w, "/// URDF joint name of each actuated joint.");
     let names: Vec<_> = chain.joints.iter().map(|j| format!("{:?}", j.name)).collect();
     wl(
@@ -174,7 +217,7 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
     wl(w, "            ],");
     wl(w, "            bodies: &[");
     let mut hull_start = 0;
-    for b in &chain.bodies {
+    for (b, graph) in chain.bodies.iter().zip(&graphs) {
         let shrink = 100.0 * (1.0 - b.tight.volume() / b.aabb.volume());
         wl(
             w,
@@ -195,6 +238,16 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         wl(w, &format!("                    frame: {},", b.frame));
         wl(w, &format!("                    hull_start: {hull_start},"));
         wl(w, &format!("                    hull_len: {},", b.points.len()));
+        match graph {
+            Some((_, seeds)) => wl(
+                w,
+                &format!("                    hull_seeds: Some({seeds:?}), // farthest along ±x, ±y, ±z"),
+            ),
+            None => wl(
+                w,
+                "                    hull_seeds: None, // a vertex on no hull edge: scan them all",
+            ),
+        }
         wl(w, &format!("                    center: {},", vec3(&b.tight.center)));
         wl(
             w,
@@ -221,6 +274,8 @@ pub fn robot_tables(chain: &Chain, source: &str) -> String {
         }
     }
     wl(w, "            ],");
+    wl(w, "            hull_edge_start: &HULL_EDGE_START,");
+    wl(w, "            hull_neighbours: &HULL_NEIGHBOURS,");
     wl(w, "            self_pairs: &SELF_PAIR_TABLE,");
     wl(w, "            frame_names: &FRAME_NAMES,");
     wl(w, "            body_names: &BODY_NAMES,");

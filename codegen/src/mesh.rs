@@ -199,6 +199,48 @@ pub fn hull_vertices(points: &[Vec3]) -> Vec<Vec3> {
     points.iter().zip(keep).filter(|(_, k)| *k).map(|(p, _)| *p).collect()
 }
 
+/// The edges of the convex hull of `points` (every one a hull vertex, as [`hull_vertices`]
+/// keeps them) as each vertex's neighbours in ascending order, and the vertices farthest along
+/// +x, −x, +y, −y, +z, −z (the first of equals): where a support query starts climbing
+/// (`edmp_core::collision::convex::Hull`). `None` when some point is on no hull edge, so that a
+/// climb could not reach it: the checker then scans every point.
+pub fn hull_graph(points: &[Vec3]) -> Option<(Vec<Vec<usize>>, [usize; 6])> {
+    let faces = convex_hull(points);
+    let mut neighbours = vec![Vec::new(); points.len()];
+    for f in &faces {
+        for e in 0..3 {
+            let (a, b) = (f[e], f[(e + 1) % 3]);
+            neighbours[a].push(b);
+            neighbours[b].push(a);
+        }
+    }
+    for n in &mut neighbours {
+        n.sort_unstable();
+        n.dedup();
+    }
+    if neighbours.iter().any(|n| n.len() < 3) {
+        return None;
+    }
+    let extreme = |axis: usize, sign: f64| {
+        (0..points.len()).fold(0, |best, i| {
+            if sign * points[i][axis] > sign * points[best][axis] {
+                i
+            } else {
+                best
+            }
+        })
+    };
+    let seeds = [
+        extreme(0, 1.0),
+        extreme(0, -1.0),
+        extreme(1, 1.0),
+        extreme(1, -1.0),
+        extreme(2, 1.0),
+        extreme(2, -1.0),
+    ];
+    Some((neighbours, seeds))
+}
+
 const HULL_EPS: f64 = 1e-12;
 
 fn sub(a: &Vec3, b: &Vec3) -> Vec3 {
@@ -489,6 +531,30 @@ mod tests {
                 assert!(height(&pts, f, p) <= 1e-9);
             }
         }
+    }
+
+    #[test]
+    fn hull_graph_joins_each_corner_of_a_box_to_its_edges() {
+        let pts = cube_corners(&math::IDENTITY, [0.1, 0.2, 0.3], [0.0, 0.0, 0.0]);
+        let (neighbours, seeds) = hull_graph(&pts).unwrap();
+        for (i, n) in neighbours.iter().enumerate() {
+            // Three box edges at each corner, and the triangles' diagonals on its faces.
+            let along_edges = n
+                .iter()
+                .filter(|&&j| (0..3).filter(|&k| pts[i][k] != pts[j][k]).count() == 1);
+            assert_eq!(along_edges.count(), 3, "{i}: {n:?}");
+            assert!(n.iter().all(|&j| j != i && neighbours[j].contains(&i)));
+        }
+        for (s, (axis, sign)) in seeds
+            .iter()
+            .zip([(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0)])
+        {
+            assert!(pts.iter().all(|p| sign * p[axis] <= sign * pts[*s][axis]));
+        }
+        // A point inside the hull is on no edge: no graph, so the checker scans.
+        let mut inside = pts.clone();
+        inside.push([0.0; 3]);
+        assert!(hull_graph(&inside).is_none());
     }
 
     #[test]

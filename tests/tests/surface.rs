@@ -30,10 +30,7 @@ fn configuration() -> impl Strategy<Value = [f32; 7]> {
 /// from that point to the hull (`gap`) and the foot on the hull.
 fn beyond(q: &[f32; 7], b: usize, d: Vector3<f32>, gap: f32) -> (Vector3<f32>, Vector3<f32>) {
     let k = forward_with(&edmp_core::robot::PANDA, q, 0.025).unwrap();
-    let hull = Hull {
-        pose: &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)],
-        points: PANDA.hull(b),
-    };
+    let hull = Hull::of_body(&PANDA, b, &k.frames[PANDA.bodies[b].frame.min(FRAMES - 1)]);
     let foot = hull.support(&d);
     (foot, foot + d * gap)
 }
@@ -44,10 +41,7 @@ fn nearest_other(q: &[f32; 7], b: usize, p: &Element) -> f32 {
     (0..BODIES)
         .filter(|&o| o != b && PANDA.bodies[o].frame != 0)
         .map(|o| {
-            let hull = Hull {
-                pose: &k.frames[PANDA.bodies[o].frame.min(FRAMES - 1)],
-                points: PANDA.hull(o),
-            };
+            let hull = Hull::of_body(&PANDA, o, &k.frames[PANDA.bodies[o].frame.min(FRAMES - 1)]);
             distance_lower_bound(&hull, p)
         })
         .fold(f32::INFINITY, f32::min)

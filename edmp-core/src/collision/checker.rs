@@ -230,10 +230,7 @@ impl<const J: usize> Placed<'_, J> {
 
     fn hull(&self, b: usize) -> Hull<'_> {
         let frame = self.robot.bodies.get(b).map_or(0, |body| body.frame);
-        Hull {
-            pose: &self.k.frames[frame % MAX_FRAMES],
-            points: self.robot.hull(b),
-        }
+        Hull::of_body(self.robot, b, &self.k.frames[frame % MAX_FRAMES])
     }
 
     /// Whether shape `b` is the held object (or past it).

@@ -6,8 +6,10 @@
 //! and triangles of clouds and meshes.
 
 use crate::robot::kinematics::Pose;
+use crate::robot::{HullGraph, Robot};
 use crate::scene::{Obstacle, Shape};
 use crate::surface::element::{Aabb, Element, Piece};
+use core::cell::Cell;
 use nalgebra::{Matrix3, Vector3};
 
 /// A convex set known through its support function.
@@ -24,26 +26,101 @@ pub trait Convex {
 }
 
 /// The convex hull of points given in a frame placed at `pose`.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Hull<'a> {
     /// Where the points' frame is.
     pub pose: &'a Pose<f32>,
     /// The points, in that frame.
     pub points: &'a [Vector3<f32>],
+    /// The hull's edges, if known: the support climbs them instead of scanning every point.
+    pub graph: Option<HullGraph<'a>>,
+    /// Where the last climb ended: GJK asks for nearby directions in turn, so the next climb
+    /// starts there and takes a step or two.
+    pub last: Cell<Option<u16>>,
 }
 
-impl Convex for Hull<'_> {
-    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
-        let local = self.pose.rotation.tr_mul(d);
+impl<'a> Hull<'a> {
+    /// Robot body `body`'s hull, placed at `pose` (its link frame's pose).
+    pub fn of_body<const J: usize>(robot: &'a Robot<f32, J>, body: usize, pose: &'a Pose<f32>) -> Self {
+        Self {
+            pose,
+            points: robot.hull(body),
+            graph: robot.hull_graph(body),
+            last: Cell::new(None),
+        }
+    }
+
+    /// The first of the points with the largest `⟨p, local⟩`, by a scan (the zero vector if
+    /// there is none, or the direction is not finite).
+    fn scan(&self, local: &Vector3<f32>) -> Vector3<f32> {
         let mut best = Vector3::zeros();
         let mut best_dot = f32::NEG_INFINITY;
         for p in self.points {
-            let dot = p.dot(&local);
+            let dot = p.dot(local);
             if dot > best_dot {
                 best_dot = dot;
                 best = *p;
             }
         }
+        best
+    }
+
+    /// The point with the largest `⟨p, local⟩`, by climbing the hull's edges from the seed
+    /// farthest along `local`'s largest component to a vertex whose every neighbour is lower.
+    /// On a convex hull that vertex is the largest of all; `None` (scan instead) when a
+    /// neighbour ties it (the scan's first-of-equals rule decides), the direction is not finite
+    /// or the tables do not fit the points.
+    fn climb(&self, graph: &HullGraph<'_>, local: &Vector3<f32>) -> Option<Vector3<f32>> {
+        let [x, y, z] = [local.x, local.y, local.z];
+        if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+            return None;
+        }
+        let start = match self.last.get() {
+            Some(last) => last,
+            None => {
+                let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
+                let seed = if ax >= ay && ax >= az {
+                    usize::from(x < 0.0)
+                } else if ay >= az {
+                    2 + usize::from(y < 0.0)
+                } else {
+                    4 + usize::from(z < 0.0)
+                };
+                *graph.seeds.get(seed)?
+            }
+        };
+        let mut at = usize::from(start);
+        let mut at_dot = self.points.get(at)?.dot(local);
+        // Every move is to a strictly larger value, so no vertex is visited twice.
+        for _ in 0..self.points.len() {
+            let (mut next, mut next_dot, mut tie) = (at, at_dot, false);
+            for &n in graph.neighbours(at) {
+                let dot = self.points.get(usize::from(n))?.dot(local);
+                tie |= dot == at_dot;
+                if dot > next_dot {
+                    (next, next_dot) = (usize::from(n), dot);
+                }
+            }
+            if next == at {
+                if tie {
+                    return None;
+                }
+                self.last.set(u16::try_from(at).ok());
+                return self.points.get(at).copied();
+            }
+            (at, at_dot) = (next, next_dot);
+        }
+        None
+    }
+}
+
+impl Convex for Hull<'_> {
+    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
+        let local = self.pose.rotation.tr_mul(d);
+        let best = match &self.graph {
+            Some(graph) => self.climb(graph, &local).unwrap_or_else(|| self.scan(&local)),
+            None => self.scan(&local),
+        };
         self.pose.transform_point(&best)
     }
 }
@@ -261,6 +338,67 @@ mod tests {
         let a = Solid::obstacle(&Obstacle::cuboid([0.0; 3], [0.2, 0.4, 0.6], id).unwrap());
         assert!((a.face_gap(&p) - 0.05).abs() < 1e-5, "{}", a.face_gap(&p));
         assert!(a.face_gap(&a) < 0.0);
+    }
+
+    /// Every body of `robot`: climbing its hull's edges (warm-started from the last climb, as
+    /// in GJK) gives the scan's point, bit for bit, in 3,000 random directions, the axes and
+    /// directions that tie (zero, and each body's hull face normals near the axes).
+    fn climbs_end_where_scans_do<const J: usize>(robot: &Robot<f32, J>) {
+        let pose = Pose::identity();
+        let mut rng = Rng::new(7);
+        let (mut climbs, mut scans) = (0, 0);
+        for b in 0..robot.bodies.len() {
+            let hull = Hull::of_body(robot, b, &pose);
+            assert!(hull.graph.is_some(), "{} body {b} has no hull graph", robot.name);
+            let scan = Hull {
+                graph: None,
+                ..hull.clone()
+            };
+            let mut directions = std::vec![Vector3::zeros()];
+            for axis in 0..3 {
+                for sign in [1.0, -1.0] {
+                    directions.push(Vector3::ith(axis, sign));
+                }
+            }
+            for _ in 0..3000 {
+                let d = Vector3::new(rng.normal_f32(), rng.normal_f32(), rng.normal_f32());
+                // Every fifth direction rounded to a coarse grid: ties between hull vertices.
+                directions.push(if directions.len() % 5 == 0 {
+                    d.map(|x| (x * 2.0).round())
+                } else {
+                    d
+                });
+            }
+            for d in &directions {
+                let (got, want) = (hull.support(d), scan.support(d));
+                assert_eq!(got, want, "{} body {b}, direction {d:?}", robot.name);
+                if hull.climb(hull.graph.as_ref().unwrap(), d).is_some() {
+                    climbs += 1;
+                } else {
+                    scans += 1;
+                }
+            }
+        }
+        // Most queries climb; some tie and scan.
+        assert!(climbs > 10 * scans && scans > 0, "{climbs} climbs, {scans} scans");
+    }
+
+    #[test]
+    #[cfg(feature = "panda")]
+    fn panda_hull_climbs_end_where_scans_do() {
+        climbs_end_where_scans_do(&crate::robot::arms::panda::ROBOT);
+    }
+
+    #[test]
+    #[cfg(feature = "iiwa7")]
+    fn iiwa7_hull_climbs_end_where_scans_do() {
+        climbs_end_where_scans_do(&crate::robot::arms::iiwa7::ROBOT);
+    }
+
+    #[test]
+    #[cfg(feature = "xarm6")]
+    fn xarm6_hull_climbs_end_where_scans_do() {
+        climbs_end_where_scans_do(&crate::robot::arms::xarm6::ROBOT);
     }
 
     #[test]

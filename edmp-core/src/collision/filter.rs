@@ -49,10 +49,7 @@ pub fn filter_robot<const J: usize>(
             if (v - c).norm_squared() > (r + distance) * (r + distance) {
                 return false;
             }
-            let hull = Hull {
-                pose: &k.frames[robot.bodies[b].frame.min(MAX_FRAMES - 1)],
-                points: robot.hull(b),
-            };
+            let hull = Hull::of_body(robot, b, &k.frames[robot.bodies[b].frame.min(MAX_FRAMES - 1)]);
             distance_lower_bound(&hull, &Point(v)) <= distance
         });
         if !own {

@@ -129,16 +129,9 @@ pub fn trajectory_cost<const H: usize, const N: usize, const J: usize>(
             for b in (0..robot.bodies.len().min(MAX_BODIES)).filter(|&b| moves(robot, b)) {
                 let Some(body) = robot.bodies.get(b) else { continue };
                 let frame = body.frame.min(MAX_FRAMES - 1);
-                let points = robot.hull(b);
                 let (hb, hc) = (
-                    Hull {
-                        pose: &kb.frames[frame],
-                        points,
-                    },
-                    Hull {
-                        pose: &kc.frames[frame],
-                        points,
-                    },
+                    Hull::of_body(robot, b, &kb.frames[frame]),
+                    Hull::of_body(robot, b, &kc.frames[frame]),
                 );
                 let half = &body.half_extents;
                 let (Some(box_b), Some(box_c), Some(&r)) = (kb.boxes.get(b), kc.boxes.get(b), radius.get(b)) else {

@@ -50,12 +50,38 @@ pub struct BodySpec<T> {
     pub hull_start: usize,
     /// How many vertices: their convex hull is the body's exact geometry.
     pub hull_len: usize,
+    /// The vertices farthest along the link frame's +x, −x, +y, −y, +z, −z, where a support
+    /// query starts climbing the hull's edges (`Robot::hull_edge_start`); `None`: scan them all.
+    pub hull_seeds: Option<[u16; 6]>,
     /// Box centre in that frame.
     pub center: Vector3<T>,
     /// Box axes (columns) in that frame.
     pub rotation: Matrix3<T>,
     /// Half of the full extent along each box axis.
     pub half_extents: Vector3<T>,
+}
+
+/// The edges of one body's convex hull: a linear function's largest value over the hull's
+/// vertices is at a vertex none of whose neighbours has a larger one, so a support query can
+/// climb along edges instead of scanning every vertex (`collision::convex::Hull`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HullGraph<'a> {
+    /// Vertex `i`'s neighbours are `neighbours[start[i]..start[i + 1]]`.
+    pub start: &'a [u16],
+    /// Neighbours, as indices into the body's vertices.
+    pub neighbours: &'a [u16],
+    /// The vertices farthest along +x, −x, +y, −y, +z, −z of the body's frame.
+    pub seeds: [u16; 6],
+}
+
+impl HullGraph<'_> {
+    /// Vertex `i`'s neighbours (empty for an index outside the body).
+    pub fn neighbours(&self, i: usize) -> &[u16] {
+        match (self.start.get(i), self.start.get(i + 1)) {
+            (Some(&a), Some(&b)) => self.neighbours.get(usize::from(a)..usize::from(b)).unwrap_or(&[]),
+            _ => &[],
+        }
+    }
 }
 
 /// An arm's gripper: the range of its opening and the default an absent `gripper` field means.
@@ -80,6 +106,11 @@ pub struct Robot<T: 'static, const J: usize> {
     pub bodies: &'static [BodySpec<T>],
     /// Collision-mesh vertices of every body (link frame), sliced by `BodySpec::hull_start/len`.
     pub hull_points: &'static [Vector3<T>],
+    /// Where each vertex's neighbours along its hull's edges begin in `hull_neighbours`
+    /// (indexed like `hull_points`, then one past the end).
+    pub hull_edge_start: &'static [u16],
+    /// Each hull vertex's neighbours, as indices into its body's vertices.
+    pub hull_neighbours: &'static [u16],
     /// Body pairs `(a, b)`, `a < b`, checked against each other for self-collision.
     pub self_pairs: &'static [(u8, u8)],
     /// URDF link name of each frame.
@@ -186,6 +217,16 @@ impl<T: Real, const J: usize> Robot<T, J> {
             .get(body)
             .and_then(|b| self.hull_points.get(b.hull_start..b.hull_start + b.hull_len))
             .unwrap_or(&[])
+    }
+
+    /// The edges of body `body`'s hull, if the tables have them.
+    pub fn hull_graph(&self, body: usize) -> Option<HullGraph<'_>> {
+        let b = self.bodies.get(body)?;
+        Some(HullGraph {
+            start: self.hull_edge_start.get(b.hull_start..=b.hull_start + b.hull_len)?,
+            neighbours: self.hull_neighbours,
+            seeds: b.hull_seeds?,
+        })
     }
 
     /// Whether `ancestor` is `frame` or lies on its path to the root.
