@@ -41,8 +41,10 @@ run k5 --steps 5 --gradient-steps 4
 run k10 --steps 10
 run k25 --steps 25 --gradient-steps 2
 # Switches of the global stage and the refinement (CHANGELOG.md, 2026-12-02): the classical
-# search, no stall stop, rows that share their first draw of noise.
+# search, no stall stop, rows that share their first draw of noise; and the search that checks
+# every edge it grows (CHANGELOG.md, 2026-12-07).
 run unseeded-search --no-search-seed
+run eager-search --eager-search
 run no-stall --refine-stall 0
 run start-draws-4 --start-draws 4
 run start-draws-1 --start-draws 1

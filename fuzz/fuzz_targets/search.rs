@@ -46,6 +46,7 @@ fuzz_target!(|data: &[u8]| {
         step: if flags & 8 == 0 { f32::from(r.byte() % 60 + 1) / 100.0 } else { r.raw() },
         shortcuts: u32::from(r.byte() % 64),
         max_nodes: u16::from(r.byte()),
+        lazy: flags & 32 == 0,
     };
     let fail_after = if flags & 16 == 0 { u32::MAX } else { u32::from(r.byte()) };
     let mut rng = Rng::new(u64::from(r.byte()));

@@ -14,9 +14,14 @@
 //!   no clock. Work is bounded by the counts in [`SearchConfig`]; the worst-case number of
 //!   validity queries is [`SearchConfig::max_oracle_calls`].
 //! - **Validity is an oracle.** The caller passes `edge_free(a, b)`: is the straight
-//!   joint-space segment from `a` to `b`, both ends included, collision-free? The search never
-//!   calls the checker itself, so it can be tested with analytic obstacles and wired to the
-//!   exact checker (`checker::check_trajectory(scene, &[*a, *b], ..)`) by the planner.
+//!   joint-space segment from `a` to `b`, both ends included, collision-free? (`a == b` asks
+//!   about one configuration.) The search never calls the checker itself, so it can be tested
+//!   with analytic obstacles and wired to the exact checker (a `SegmentChecker`) by the planner.
+//! - **Lazy edges** ([`SearchConfig::lazy`], the default): a new node is checked alone and
+//!   the edge to it only once it lies on a path between the roots, root side first; a blocked
+//!   edge drops its node and what grew from it, and a full tree reuses dropped nodes' slots.
+//!   Most edges a search grows lead nowhere, and a node alone is one state of the checker
+//!   where an edge is up to thirty. What the search returns was checked edge by edge, as before.
 
 // Never panic: no indexing, unwrapping or unchecked integer arithmetic outside the tests.
 #![deny(
@@ -62,6 +67,11 @@ pub struct SearchConfig {
     /// Nodes per tree, the root included; the space's `CAP` caps it (`u16::MAX` means "all of
     /// `CAP`"), so one static space can serve smaller budgets.
     pub max_nodes: u16,
+    /// Lazy edges: a new node is checked alone (`edge_free(q, q)`), and the edge to it only
+    /// when it lies on a path between the roots; a blocked edge drops its node and everything
+    /// grown from it, and the trees grow on. Most edges a search grows are never on its path,
+    /// so it checks a fraction of their states; the path it returns is checked like any other.
+    pub lazy: bool,
 }
 
 impl SearchConfig {
@@ -77,6 +87,7 @@ impl SearchConfig {
         step: 0.3,
         shortcuts: 25,
         max_nodes: u16::MAX,
+        lazy: true,
     };
 
     /// Nodes per tree that a [`SearchSpace<CAP>`] with `CAP = capacity` allows.
@@ -88,7 +99,8 @@ impl SearchConfig {
     /// Worst-case calls of `edge_free` in one [`search`] with a space of `capacity` nodes per
     /// tree (`N = tree_capacity(capacity)`):
     ///
-    /// `1 + max_iterations + 3 + 2 (N − 1) + shortcuts + 2 (HORIZON − 1)`.
+    /// `1 + max_iterations + 3 + 2 (N − 1) + shortcuts + 2 (HORIZON − 1)`, plus `6 (N − 1)` when
+    /// [`lazy`](Self::lazy).
     ///
     /// Why: one call for the direct start–goal edge; during growth every call either adds a
     /// node (at most `N − 1` per tree) or fails, and each iteration has at most one failing
@@ -96,12 +108,17 @@ impl SearchConfig {
     /// a seed path ([`search_from`]) adds at most three failing calls (the chain from each
     /// root, then the connect of the goal tree to the start chain's tip); one call per shortcut
     /// attempt; `HORIZON − 1` calls to verify the evenly resampled path and as many again for
-    /// the vertex-keeping fallback. Besides the oracle, each extension scans its tree for the
-    /// nearest node (at most `N` distances).
+    /// the vertex-keeping fallback. A lazy tree adds at most `2 (N − 1)` nodes over the
+    /// search (a full tree reuses its dropped nodes' slots), each with one call for the node
+    /// and at most one for the edge to it, when the trees meet. Besides the oracle, each
+    /// extension scans its tree for the nearest node (at most `N` distances).
     pub const fn max_oracle_calls(&self, capacity: usize) -> u64 {
         let nodes = self.tree_capacity(capacity) as u64;
-        let growth = (self.max_iterations as u64).saturating_add(nodes.saturating_sub(1).saturating_mul(2));
+        let edges = nodes.saturating_sub(1).saturating_mul(2);
+        let growth = (self.max_iterations as u64).saturating_add(edges);
+        let lazy = if self.lazy { edges.saturating_mul(3) } else { 0 };
         growth
+            .saturating_add(lazy)
             .saturating_add(1 + SEED_FAILS)
             .saturating_add(self.shortcuts as u64)
             .saturating_add(VERIFY_CALLS)
@@ -123,14 +140,29 @@ impl Default for SearchConfig {
 }
 
 /// Memory of one search: two trees of at most `CAP` nodes (`1 ≤ CAP ≤ u16::MAX`), each node a
-/// configuration and the `u16` index of its parent. About `60 · CAP` bytes.
+/// configuration, the `u16` index of its parent, whether the edge to it is checked and where
+/// it moves when the tree is compacted. About `66 · CAP` bytes.
 ///
 /// Reusable: every [`search`] starts by clearing it. `new` is `const`, so on a
 /// microcontroller it can sit in a `static` instead of on the stack.
 pub struct SearchSpace<const CAP: usize, const J: usize = JOINTS> {
     nodes: [[Joints<f32, J>; CAP]; 2],
     parents: [[u16; CAP]; 2],
+    edges: [[Edge; CAP]; 2],
+    moved_to: [[u16; CAP]; 2],
     len: [usize; 2],
+    added: [usize; 2],
+}
+
+/// What is known of the edge from a node's parent to it (the root's: `Checked`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Edge {
+    /// Free by the oracle.
+    Checked,
+    /// Its node is free; the edge is checked when it lies on a path ([`SearchConfig::lazy`]).
+    Unchecked,
+    /// Blocked, or below a blocked one: the node is out of the tree.
+    Dropped,
 }
 
 impl<const CAP: usize, const J: usize> SearchSpace<CAP, J> {
@@ -148,7 +180,10 @@ impl<const CAP: usize, const J: usize> SearchSpace<CAP, J> {
         Self {
             nodes: [[[0.0; J]; CAP]; 2],
             parents: [[0; CAP]; 2],
+            edges: [[Edge::Checked; CAP]; 2],
+            moved_to: [[0; CAP]; 2],
             len: [0; 2],
+            added: [0; 2],
         }
     }
 }
@@ -326,27 +361,81 @@ impl<F> Oracle<'_, F> {
 struct Tree<'a, const CAP: usize, const J: usize> {
     nodes: &'a mut [Joints<f32, J>; CAP],
     parents: &'a mut [u16; CAP],
+    edges: &'a mut [Edge; CAP],
+    moved_to: &'a mut [u16; CAP],
     len: &'a mut usize,
+    /// Nodes added since the root was planted.
+    added: &'a mut usize,
     capacity: usize,
+    /// Nodes it may add in all: `capacity − 1`, twice that when lazy (dropped nodes' slots are
+    /// reused).
+    limit: usize,
 }
 
 impl<const CAP: usize, const J: usize> Tree<'_, CAP, J> {
     fn plant(&mut self, root: &Joints<f32, J>) {
-        if let (Some(n), Some(p)) = (self.nodes.first_mut(), self.parents.first_mut()) {
+        if let (Some(n), Some(p), Some(e)) = (self.nodes.first_mut(), self.parents.first_mut(), self.edges.first_mut())
+        {
             *n = *root;
             *p = 0;
+            *e = Edge::Checked;
             *self.len = 1;
+            *self.added = 0;
         }
+    }
+
+    /// Whether a node can be added: within the limit, and a free slot, made by compacting the
+    /// tree (dropping its dropped nodes) when it is full.
+    fn has_room(&mut self) -> bool {
+        if *self.added >= self.limit {
+            return false;
+        }
+        if *self.len < self.capacity {
+            return true;
+        }
+        self.compact();
+        *self.len < self.capacity
+    }
+
+    /// Moves the nodes that are not dropped to the front, in order, their links renumbered
+    /// (a parent comes before its children, so its new index is known when they move).
+    fn compact(&mut self) {
+        let mut kept = 0usize;
+        for i in 0..*self.len {
+            let (Some(&edge), Some(&parent), Some(&q)) = (self.edges.get(i), self.parents.get(i), self.nodes.get(i))
+            else {
+                break;
+            };
+            if edge == Edge::Dropped {
+                continue;
+            }
+            let link = self.moved_to.get(usize::from(parent)).copied().unwrap_or(0);
+            let new = u16::try_from(kept).unwrap_or(NO_NODE);
+            if let (Some(m), Some(n), Some(p), Some(e)) = (
+                self.moved_to.get_mut(i),
+                self.nodes.get_mut(kept),
+                self.parents.get_mut(kept),
+                self.edges.get_mut(kept),
+            ) {
+                (*m, *n, *p, *e) = (new, q, if i == 0 { 0 } else { link }, edge);
+            }
+            kept = kept.saturating_add(1);
+        }
+        *self.len = kept;
     }
 
     fn grown(&self) -> &[Joints<f32, J>] {
         self.nodes.get(..*self.len).unwrap_or(&[])
     }
 
-    /// Index and value of the node nearest to `q` (Euclidean; the first on ties).
+    /// Index and value of the node nearest to `q` (Euclidean; the first on ties), dropped
+    /// nodes left out.
     fn nearest(&self, q: &Joints<f32, J>) -> Option<(usize, Joints<f32, J>)> {
         let mut best: Option<(f32, usize, Joints<f32, J>)> = None;
-        for (i, n) in self.grown().iter().enumerate() {
+        for ((i, n), e) in self.grown().iter().enumerate().zip(self.edges.iter()) {
+            if *e == Edge::Dropped {
+                continue;
+            }
             let d = distance2(n, q);
             if best.is_none_or(|(b, _, _)| d < b) {
                 best = Some((d, i, *n));
@@ -355,17 +444,99 @@ impl<const CAP: usize, const J: usize> Tree<'_, CAP, J> {
         best.map(|(_, i, n)| (i, n))
     }
 
-    /// Appends `q` under `parent` (< the new index, which [`compact_chain`] relies on).
-    fn push(&mut self, q: Joints<f32, J>, parent: usize) -> Option<usize> {
+    /// Appends `q` under `parent` (< the new index, which [`compact_chain`] and
+    /// [`Tree::drop_below`] rely on).
+    fn push(&mut self, q: Joints<f32, J>, parent: usize, edge: Edge) -> Option<usize> {
         let i = *self.len;
         if i >= self.capacity {
+            return None;
+        }
+        if *self.added >= self.limit {
             return None;
         }
         let link = u16::try_from(parent).ok()?;
         *self.nodes.get_mut(i)? = q;
         *self.parents.get_mut(i)? = link;
+        *self.edges.get_mut(i)? = edge;
         *self.len = i.saturating_add(1);
+        *self.added = self.added.saturating_add(1);
         Some(i)
+    }
+
+    /// Checks the unchecked edges on the chain from the root down to `leaf`, root side first
+    /// (a blocked edge drops every node below it, so none of their edges is checked in vain):
+    /// `true` when all are free. A blocked edge drops its node and every node below it.
+    fn check_chain<F>(&mut self, leaf: usize, oracle: &mut Oracle<'_, F>) -> Result<bool, Error>
+    where
+        F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
+    {
+        // Turn the chain's links to point from the root towards the leaf (the leaf's: NO_NODE),
+        // walk it down, then turn them back. Parents have smaller indices: at most `len` steps.
+        let (mut prev, mut cur) = (NO_NODE, leaf);
+        for _ in 0..*self.len {
+            let Some(link) = self.parents.get_mut(cur) else { break };
+            let next = usize::from(*link);
+            *link = prev;
+            prev = u16::try_from(cur).unwrap_or(NO_NODE);
+            if cur == 0 || next >= cur {
+                break;
+            }
+            cur = next;
+        }
+        let (mut parent, mut blocked) = (usize::from(prev), None);
+        for _ in 0..*self.len {
+            let Some(&link) = self.parents.get(parent) else { break };
+            if link == NO_NODE {
+                break;
+            }
+            let child = usize::from(link);
+            if blocked.is_none() && self.edges.get(child) == Some(&Edge::Unchecked) {
+                let (Some(from), Some(to)) = (self.nodes.get(parent).copied(), self.nodes.get(child).copied()) else {
+                    break;
+                };
+                if oracle.free(&from, &to)? {
+                    if let Some(e) = self.edges.get_mut(child) {
+                        *e = Edge::Checked;
+                    }
+                } else {
+                    blocked = Some(child);
+                }
+            }
+            parent = child;
+        }
+        let (mut prev, mut cur) = (0u16, usize::from(prev));
+        for _ in 0..*self.len {
+            let Some(link) = self.parents.get_mut(cur) else { break };
+            let next = *link;
+            *link = prev;
+            if next == NO_NODE {
+                break;
+            }
+            prev = u16::try_from(cur).unwrap_or(NO_NODE);
+            cur = usize::from(next);
+        }
+        match blocked {
+            Some(node) => {
+                self.drop_below(node);
+                Ok(false)
+            }
+            None => Ok(true),
+        }
+    }
+
+    /// Drops `node` and its descendants (one pass: a child comes after its parent).
+    fn drop_below(&mut self, node: usize) {
+        if let Some(e) = self.edges.get_mut(node) {
+            *e = Edge::Dropped;
+        }
+        for i in node.saturating_add(1)..*self.len {
+            let parent = self.parents.get(i).map_or(0, |&p| usize::from(p));
+            if self.edges.get(parent) == Some(&Edge::Dropped)
+                && let Some(e) = self.edges.get_mut(i)
+            {
+                *e = Edge::Dropped;
+            }
+        }
     }
 }
 
@@ -381,27 +552,33 @@ enum Extension {
     Reached(usize),
 }
 
-/// One step of `tree` from its nearest node towards `target`.
+/// One step of `tree` from its nearest node towards `target`: the edge checked, or with
+/// `config.lazy` the new node alone.
 fn extend<const CAP: usize, F, const J: usize>(
     tree: &mut Tree<'_, CAP, J>,
     target: &Joints<f32, J>,
-    step: f32,
+    config: &SearchConfig,
     oracle: &mut Oracle<'_, F>,
 ) -> Result<Extension, Error>
 where
     F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
-    if *tree.len >= tree.capacity {
+    if !tree.has_room() {
         return Ok(Extension::Full);
     }
     let Some((near, from)) = tree.nearest(target) else {
         return Ok(Extension::Full);
     };
-    let q = steer(&from, target, step);
-    if !oracle.free(&from, &q)? {
+    let q = steer(&from, target, config.step);
+    let (checked_from, edge) = if config.lazy {
+        (&q, Edge::Unchecked)
+    } else {
+        (&from, Edge::Checked)
+    };
+    if !oracle.free(checked_from, &q)? {
         return Ok(Extension::Trapped);
     }
-    Ok(match tree.push(q, near) {
+    Ok(match tree.push(q, near, edge) {
         None => Extension::Full,
         Some(i) if q == *target => Extension::Reached(i),
         Some(i) => Extension::Advanced(i),
@@ -425,22 +602,39 @@ where
     F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
     let capacity = config.tree_capacity(CAP);
+    let additions = capacity.saturating_sub(1);
+    let limit = if config.lazy {
+        additions.saturating_mul(2)
+    } else {
+        additions
+    };
     let SearchSpace {
         nodes: [n0, n1],
         parents: [p0, p1],
+        edges: [e0, e1],
+        moved_to: [m0, m1],
         len: [l0, l1],
+        added: [a0, a1],
     } = space;
     let mut s = Tree {
         nodes: n0,
         parents: p0,
+        edges: e0,
+        moved_to: m0,
         len: l0,
+        added: a0,
         capacity,
+        limit,
     };
     let mut g = Tree {
         nodes: n1,
         parents: p1,
+        edges: e1,
+        moved_to: m1,
         len: l1,
+        added: a1,
         capacity,
+        limit,
     };
     s.plant(start);
     g.plant(goal);
@@ -450,10 +644,14 @@ where
     if let Some(tip) = tip
         && let Some(target) = s.grown().get(tip).copied()
     {
-        match connect(&mut g, &target, config.step, oracle)? {
+        match connect(&mut g, &target, config, oracle)? {
             Connect::Full => return Ok(None),
             Connect::Trapped => {}
-            Connect::Reached(j) => return Ok(Some((tip, j))),
+            Connect::Reached(j) => {
+                if met(&mut s, tip, &mut g, j, oracle)? {
+                    return Ok(Some((tip, j)));
+                }
+            }
         }
     }
     let mut from_start = true;
@@ -464,16 +662,21 @@ where
             *v = rng.uniform_f32(*lo, *hi);
         }
         let (a, b) = if from_start { (&mut s, &mut g) } else { (&mut g, &mut s) };
-        let new = match extend(a, &sample, config.step, oracle)? {
+        let new = match extend(a, &sample, config, oracle)? {
             Extension::Full => return Ok(None),
             Extension::Trapped => None,
             Extension::Advanced(i) | Extension::Reached(i) => Some(i),
         };
         if let Some((i, target)) = new.and_then(|i| a.grown().get(i).map(|q| (i, *q))) {
-            match connect(b, &target, config.step, oracle)? {
+            match connect(b, &target, config, oracle)? {
                 Connect::Full => return Ok(None),
                 Connect::Trapped => {}
-                Connect::Reached(j) => return Ok(Some(if from_start { (i, j) } else { (j, i) })),
+                Connect::Reached(j) => {
+                    let (si, gi) = if from_start { (i, j) } else { (j, i) };
+                    if met(&mut s, si, &mut g, gi, oracle)? {
+                        return Ok(Some((si, gi)));
+                    }
+                }
             }
         }
         from_start = !from_start;
@@ -496,20 +699,36 @@ enum Connect {
 fn connect<const CAP: usize, F, const J: usize>(
     tree: &mut Tree<'_, CAP, J>,
     target: &Joints<f32, J>,
-    step: f32,
+    config: &SearchConfig,
     oracle: &mut Oracle<'_, F>,
 ) -> Result<Connect, Error>
 where
     F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
 {
     loop {
-        match extend(tree, target, step, oracle)? {
+        match extend(tree, target, config, oracle)? {
             Extension::Full => return Ok(Connect::Full),
             Extension::Trapped => return Ok(Connect::Trapped),
             Extension::Advanced(_) => {}
             Extension::Reached(j) => return Ok(Connect::Reached(j)),
         }
     }
+}
+
+/// Whether the trees, met at node `si` of the start tree and `gi` of the goal tree, join the
+/// roots by checked edges: the unchecked ones on the way are checked now (start side first),
+/// and a blocked one drops its node and what grew from it ([`SearchConfig::lazy`]).
+fn met<const CAP: usize, F, const J: usize>(
+    s: &mut Tree<'_, CAP, J>,
+    si: usize,
+    g: &mut Tree<'_, CAP, J>,
+    gi: usize,
+    oracle: &mut Oracle<'_, F>,
+) -> Result<bool, Error>
+where
+    F: FnMut(&Joints<f32, J>, &Joints<f32, J>) -> Result<bool, Error>,
+{
+    Ok(s.check_chain(si, oracle)? && g.check_chain(gi, oracle)?)
 }
 
 /// Appends `chain` to `tree` from its root, each waypoint under the one before, while the edge
@@ -535,7 +754,7 @@ where
         if check_finite(q).is_err() || check_within_limits(robot, q).is_err() || !oracle.free(&from, q)? {
             break;
         }
-        let Some(i) = tree.push(*q, last) else {
+        let Some(i) = tree.push(*q, last, Edge::Checked) else {
             break;
         };
         (last, added) = (i, Some(i));
@@ -1018,6 +1237,93 @@ mod tests {
 
     #[test]
     #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
+    fn lazy_trees_drop_the_edges_through_a_thin_wall() {
+        // A wall thinner than a step: single nodes land on both sides of it, so lazy trees meet
+        // through it, check the edges between and drop what lies beyond a blocked one.
+        const THIN: Wall = Wall {
+            lo: -0.05,
+            hi: 0.05,
+            gap: Some((0.6, 1.0)),
+        };
+        let (mut dropped, mut found) = (0, 0);
+        for seed in 0..20 {
+            let config = SearchConfig::DEFAULT;
+            let mut space = Box::new(SearchSpace::<4096>::new());
+            let (mut calls, mut blocked) = (0u64, 0);
+            let mut oracle = |a: &Joints<f32>, b: &Joints<f32>| {
+                calls += 1;
+                let free = THIN.edge_free(a, b);
+                blocked += usize::from(!free && a != b && THIN.edge_free(a, a) && THIN.edge_free(b, b));
+                Ok(free)
+            };
+            let out = search(
+                &PANDA,
+                &START,
+                &GOAL,
+                &config,
+                &mut space,
+                &mut Rng::new(seed),
+                &mut oracle,
+            );
+            if let Some(o) = out.unwrap() {
+                assert_valid(&o, Some(THIN));
+                found += 1;
+            }
+            assert!(calls <= config.max_oracle_calls(4096));
+            dropped += usize::from(blocked > 0);
+        }
+        assert!(
+            dropped >= 10 && found == 20,
+            "{dropped} searches dropped edges, {found} found"
+        );
+    }
+
+    #[test]
+    fn a_full_tree_reuses_its_dropped_nodes_slots() {
+        let mut space = SearchSpace::<8>::new();
+        let SearchSpace {
+            nodes: [nodes, _],
+            parents: [parents, _],
+            edges: [edges, _],
+            moved_to: [moved_to, _],
+            len: [len, _],
+            added: [added, _],
+        } = &mut space;
+        let mut tree = Tree {
+            nodes,
+            parents,
+            edges,
+            moved_to,
+            len,
+            added,
+            capacity: 8,
+            limit: 11,
+        };
+        tree.plant(&mark(0.0));
+        // 0 ─ 1 ─ 2 ─ 4 ─ 6, and 1 ─ 3 ─ 5 ─ 7: dropping 3 drops 5 and 7.
+        for (i, parent) in [0, 1, 1, 2, 3, 4, 5].into_iter().enumerate() {
+            assert_eq!(tree.push(mark(i as f32 + 1.0), parent, Edge::Unchecked), Some(i + 1));
+        }
+        tree.drop_below(3);
+        assert!(tree.has_room(), "compacted");
+        assert_eq!(tree.grown(), [0.0, 1.0, 2.0, 4.0, 6.0].map(mark));
+        assert_eq!(tree.parents.get(..5), Some(&[0, 0, 1, 2, 3][..]));
+        assert_eq!(tree.nearest(&mark(5.0)).map(|(i, _)| i), Some(3));
+        assert_eq!(tree.push(mark(9.0), 4, Edge::Unchecked), Some(5));
+        for k in 0..2 {
+            assert!(tree.has_room());
+            tree.push(mark(10.0 + k as f32), 5, Edge::Unchecked);
+        }
+        assert!(!tree.has_room(), "full, nothing dropped");
+        // The limit counts every node added, the dropped ones too.
+        tree.drop_below(5);
+        assert!(tree.has_room() && tree.push(mark(12.0), 4, Edge::Unchecked) == Some(5));
+        assert_eq!((*tree.added, *tree.len), (11, 6));
+        assert!(!tree.has_room(), "at the limit");
+    }
+
+    #[test]
+    #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn a_closed_wall_is_no_path_within_the_budget() {
         let config = SearchConfig {
             max_iterations: 300,
@@ -1086,11 +1392,13 @@ mod tests {
     #[cfg_attr(miri, ignore = "thousands of RRT iterations: too slow under Miri")]
     fn work_stays_within_the_documented_bound() {
         // Tight budgets of every kind, against the closed wall (the worst case: no early exit).
-        for (iterations, shortcuts, nodes) in [(0, 0, 2), (1, 5, 2), (50, 10, 8), (400, 100, 64), (2000, 0, 300)] {
+        let budgets = [(0, 0, 2), (1, 5, 2), (50, 10, 8), (400, 100, 64), (2000, 0, 300)];
+        for ((iterations, shortcuts, nodes), lazy) in budgets.into_iter().flat_map(|b| [(b, true), (b, false)]) {
             let config = SearchConfig {
                 max_iterations: iterations,
                 shortcuts,
                 max_nodes: nodes,
+                lazy,
                 ..SearchConfig::DEFAULT
             };
             for wall in [CLOSED, GAPPED] {
@@ -1108,8 +1416,13 @@ mod tests {
         assert_eq!(SearchConfig::DEFAULT.tree_capacity(512), 512);
         assert_eq!(
             SearchConfig::DEFAULT.max_oracle_calls(512),
-            1 + 3 + 8000 + 2 * 511 + 25 + 98
+            1 + 3 + 8000 + 2 * 511 + 6 * 511 + 25 + 98
         );
+        let eager = SearchConfig {
+            lazy: false,
+            ..SearchConfig::DEFAULT
+        };
+        assert_eq!(eager.max_oracle_calls(512), 1 + 3 + 8000 + 2 * 511 + 25 + 98);
     }
 
     #[test]
@@ -1178,7 +1491,7 @@ mod tests {
         assert_eq!(EMPTY.len, [0, 0]);
         assert_eq!(
             SearchSpace::<512>::BYTES,
-            512 * 2 * (JOINTS * 4 + 2) + 2 * core::mem::size_of::<usize>()
+            512 * 2 * (JOINTS * 4 + 2 + 1 + 2) + 4 * core::mem::size_of::<usize>()
         );
         // One space, two searches: the second does not see the first's trees.
         let mut space = Box::new(SearchSpace::<1024>::new());
@@ -1245,7 +1558,7 @@ mod tests {
         };
         let mut oracle = |a: &Joints<f32>, b: &Joints<f32>| {
             let widest = a.iter().zip(b).map(|(x, y)| (y - x).abs()).fold(0.0f32, f32::max);
-            if widest < 0.2 {
+            if widest < 0.2 && a != b {
                 return Ok(approved.iter().any(|e| on(a, e) && on(b, e)));
             }
             let free = GAPPED.edge_free(a, b);

@@ -113,6 +113,10 @@ pub struct Tuning {
     /// also from the first stage's least colliding candidate. An ablation.
     #[arg(long)]
     no_search_seed: bool,
+    /// Global stage: check every edge the search grows in full (classical RRT-Connect) instead
+    /// of each new node alone and the edges only on a path between the roots (lazy, the default).
+    #[arg(long)]
+    eager_search: bool,
     /// Distinct draws of noise the 12 rows start from (row r: draw r mod N); the first
     /// denoising step runs the network once per draw. 12: a draw per row, as EDMP.
     #[arg(long, default_value_t = PlanConfig::DEFAULT.start_draws.min(12), value_parser = clap::value_parser!(u8).range(1..=12))]
@@ -214,6 +218,7 @@ impl Tuning {
                         max_iterations: self.search_iterations,
                         max_nodes: self.search_nodes,
                         shortcuts: self.search_shortcuts,
+                        lazy: !self.eager_search,
                         ..SearchConfig::DEFAULT
                     },
                     attempts: self.search_attempts,
@@ -325,6 +330,11 @@ impl Tuning {
         };
         let boxes = if self.no_search_seed && !self.no_global {
             format!("{boxes}, unseeded search")
+        } else {
+            boxes
+        };
+        let boxes = if self.eager_search && !self.no_global {
+            format!("{boxes}, eager search")
         } else {
             boxes
         };
