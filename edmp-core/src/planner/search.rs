@@ -215,7 +215,7 @@ pub struct SearchOutcome<const J: usize = JOINTS> {
     /// even spacing cut a corner the oracle refused and the fallback, which keeps every
     /// polyline vertex as a waypoint (spans shared out by length), was used.
     pub even: bool,
-    /// Tree nodes grown, both roots included.
+    /// Nodes in the trees when they met, both roots included (dropped nodes left out).
     pub nodes: usize,
     /// Growing iterations used (0 for a direct edge).
     pub iterations: u32,
@@ -472,6 +472,7 @@ impl<const CAP: usize, const J: usize> Tree<'_, CAP, J> {
     {
         // Turn the chain's links to point from the root towards the leaf (the leaf's: NO_NODE),
         // walk it down, then turn them back. Parents have smaller indices: at most `len` steps.
+        // An oracle error ends the whole search, whose next use plants the trees afresh.
         let (mut prev, mut cur) = (NO_NODE, leaf);
         for _ in 0..*self.len {
             let Some(link) = self.parents.get_mut(cur) else { break };
@@ -490,16 +491,16 @@ impl<const CAP: usize, const J: usize> Tree<'_, CAP, J> {
                 break;
             }
             let child = usize::from(link);
-            if blocked.is_none() && self.edges.get(child) == Some(&Edge::Unchecked) {
+            if self.edges.get(child) == Some(&Edge::Unchecked) {
                 let (Some(from), Some(to)) = (self.nodes.get(parent).copied(), self.nodes.get(child).copied()) else {
                     break;
                 };
-                if oracle.free(&from, &to)? {
-                    if let Some(e) = self.edges.get_mut(child) {
-                        *e = Edge::Checked;
-                    }
-                } else {
+                if !oracle.free(&from, &to)? {
                     blocked = Some(child);
+                    break;
+                }
+                if let Some(e) = self.edges.get_mut(child) {
+                    *e = Edge::Checked;
                 }
             }
             parent = child;
