@@ -18,16 +18,17 @@ use crate::metrics::{Roughness, acsm, path_length, roughness};
 use crate::planning::{chosen_guides, plan_problem_on};
 use crate::plots;
 use crate::with_arm;
+use core::sync::atomic::{AtomicUsize, Ordering};
 use core::time::Duration;
 use edmp_core::collision::checker::{CheckConfig, check_trajectory};
 use edmp_core::planner::Stage;
 use edmp_core::prior::Network;
 use edmp_core::robot::Robot;
 use indicatif::{ProgressBar, ProgressStyle};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// Which planner runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -399,6 +400,42 @@ pub fn families(records: &[Record]) -> Vec<String> {
     out
 }
 
+/// Stack of each of `bench`'s planning threads: a plan needs what `plan` has on the main thread.
+const PLAN_STACK: usize = 16 << 20;
+
+/// `one` over `jobs` on `threads` threads of their own, the results in the jobs' order. Not on
+/// rayon's pool: a rayon worker that waits for a plan's own parallel work (the surface's tree,
+/// the executor's pool) may start the next job on the same stack, and plans over point clouds
+/// nested that way overflowed it.
+fn on_threads<T: Sync, R: Send>(jobs: &[T], threads: usize, one: impl Fn(&T) -> R + Sync) -> Result<Vec<R>, String> {
+    let next = AtomicUsize::new(0);
+    let done: Mutex<Vec<(usize, R)>> = Mutex::new(Vec::with_capacity(jobs.len()));
+    std::thread::scope(|scope| -> Result<(), String> {
+        let work = || loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            let Some(job) = jobs.get(i) else { break };
+            let result = one(job);
+            if let Ok(mut done) = done.lock() {
+                done.push((i, result));
+            }
+        };
+        for _ in 0..threads.max(1) {
+            std::thread::Builder::new()
+                .name("edmp-bench".to_owned())
+                .stack_size(PLAN_STACK)
+                .spawn_scoped(scope, work)
+                .map_err(|e| format!("cannot start a planning thread: {e}"))?;
+        }
+        Ok(())
+    })?;
+    let mut done = done.into_inner().map_err(|_| "a planning thread panicked".to_owned())?;
+    if done.len() != jobs.len() {
+        return Err("a planning thread panicked".to_owned());
+    }
+    done.sort_by_key(|(i, _)| *i);
+    Ok(done.into_iter().map(|(_, r)| r).collect())
+}
+
 /// Runs the benchmark and writes its files.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let input = Failure::Input;
@@ -454,7 +491,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let outcomes: Vec<Result<Record, String>> = if args.serial {
         jobs.iter().map(one).collect::<Result<_, _>>()?
     } else {
-        jobs.par_iter().map(one).collect::<Result<_, _>>()?
+        let threads = std::thread::available_parallelism().map_or(2, usize::from);
+        on_threads(&jobs, threads, one)
+            .map_err(input)?
+            .into_iter()
+            .collect::<Result<_, _>>()?
     };
     bar.finish_and_clear();
     let (records, refused): (Vec<_>, Vec<_>) = outcomes.into_iter().partition(Result::is_ok);
@@ -667,6 +708,17 @@ pub fn read_results(dir: &Path) -> Result<Vec<Record>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn planning_threads_keep_the_jobs_order_and_have_a_plans_stack() {
+        let jobs: Vec<usize> = (0..200).collect();
+        // Each job uses a few MiB of stack, more than a rayon worker's default 2 MiB.
+        let deep = |&j: &usize| {
+            let buffer = std::hint::black_box([j as u8; 4 << 20]);
+            buffer.iter().map(|&b| usize::from(b)).sum::<usize>() / (4 << 20)
+        };
+        assert_eq!(on_threads(&jobs, 3, deep).unwrap(), (0..200).map(|j| j % 256).collect::<Vec<_>>());
+    }
 
     fn record(stage: Option<&str>, waves: Option<u8>, time_ms: f64) -> Record {
         Record {
