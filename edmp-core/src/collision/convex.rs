@@ -65,8 +65,9 @@ impl<'a> Hull<'a> {
         best
     }
 
-    /// The point with the largest `⟨p, local⟩`, by climbing the hull's edges from the seed
-    /// farthest along `local`'s largest component to a vertex whose every neighbour is lower.
+    /// The point with the largest `⟨p, local⟩`, by climbing the hull's edges from where the
+    /// last climb ended (the first: the seed farthest along `local`'s largest component) to a
+    /// vertex whose every neighbour is lower.
     /// On a convex hull that vertex is the largest of all; `None` (scan instead) when a
     /// neighbour ties it (the scan's first-of-equals rule decides), the direction is not finite
     /// or the tables do not fit the points.
@@ -340,9 +341,9 @@ mod tests {
         assert!(a.face_gap(&a) < 0.0);
     }
 
-    /// Every body of `robot`: climbing its hull's edges (warm-started from the last climb, as
-    /// in GJK) gives the scan's point, bit for bit, in 3,000 random directions, the axes and
-    /// directions that tie (zero, and each body's hull face normals near the axes).
+    /// Every body of `robot`: climbing its hull's edges (each climb from where the last ended,
+    /// as in GJK) gives the scan's point, bit for bit, for the zero direction, the axes and
+    /// 3,000 random directions, a fifth of them rounded to a coarse grid, where vertices tie.
     fn climbs_end_where_scans_do<const J: usize>(robot: &Robot<f32, J>) {
         let pose = Pose::identity();
         let mut rng = Rng::new(7);

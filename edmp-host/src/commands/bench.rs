@@ -717,7 +717,10 @@ mod tests {
             let buffer = std::hint::black_box([j as u8; 4 << 20]);
             buffer.iter().map(|&b| usize::from(b)).sum::<usize>() / (4 << 20)
         };
-        assert_eq!(on_threads(&jobs, 3, deep).unwrap(), (0..200).map(|j| j % 256).collect::<Vec<_>>());
+        assert_eq!(
+            on_threads(&jobs, 3, deep).unwrap(),
+            (0..200).map(|j| j % 256).collect::<Vec<_>>()
+        );
     }
 
     fn record(stage: Option<&str>, waves: Option<u8>, time_ms: f64) -> Record {
