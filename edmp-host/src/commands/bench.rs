@@ -714,7 +714,7 @@ mod tests {
         let jobs: Vec<usize> = (0..200).collect();
         // Each job uses a few MiB of stack, more than a rayon worker's default 2 MiB.
         let deep = |&j: &usize| {
-            let buffer = std::hint::black_box([j as u8; 4 << 20]);
+            let buffer = core::hint::black_box([j as u8; 4 << 20]);
             buffer.iter().map(|&b| usize::from(b)).sum::<usize>() / (4 << 20)
         };
         assert_eq!(
