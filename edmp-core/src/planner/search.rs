@@ -188,6 +188,43 @@ impl<const CAP: usize, const J: usize> SearchSpace<CAP, J> {
     }
 }
 
+impl<const CAP: usize, const J: usize> SearchSpace<CAP, J> {
+    /// The start tree and the goal tree, borrowed for growing, each holding at most `capacity`
+    /// nodes at once and adding at most `limit` in all.
+    fn trees(&mut self, capacity: usize, limit: usize) -> [Tree<'_, CAP, J>; 2] {
+        let Self {
+            nodes: [n0, n1],
+            parents: [p0, p1],
+            edges: [e0, e1],
+            moved_to: [m0, m1],
+            len: [l0, l1],
+            added: [a0, a1],
+        } = self;
+        [
+            Tree {
+                nodes: n0,
+                parents: p0,
+                edges: e0,
+                moved_to: m0,
+                len: l0,
+                added: a0,
+                capacity,
+                limit,
+            },
+            Tree {
+                nodes: n1,
+                parents: p1,
+                edges: e1,
+                moved_to: m1,
+                len: l1,
+                added: a1,
+                capacity,
+                limit,
+            },
+        ]
+    }
+}
+
 impl<const CAP: usize, const J: usize> Default for SearchSpace<CAP, J> {
     fn default() -> Self {
         Self::new()
@@ -609,34 +646,7 @@ where
     } else {
         additions
     };
-    let SearchSpace {
-        nodes: [n0, n1],
-        parents: [p0, p1],
-        edges: [e0, e1],
-        moved_to: [m0, m1],
-        len: [l0, l1],
-        added: [a0, a1],
-    } = space;
-    let mut s = Tree {
-        nodes: n0,
-        parents: p0,
-        edges: e0,
-        moved_to: m0,
-        len: l0,
-        added: a0,
-        capacity,
-        limit,
-    };
-    let mut g = Tree {
-        nodes: n1,
-        parents: p1,
-        edges: e1,
-        moved_to: m1,
-        len: l1,
-        added: a1,
-        capacity,
-        limit,
-    };
+    let [mut s, mut g] = space.trees(capacity, limit);
     s.plant(start);
     g.plant(goal);
     let inner = seed.get(1..seed.len().saturating_sub(1)).unwrap_or(&[]);
@@ -1282,24 +1292,7 @@ mod tests {
     #[test]
     fn a_full_tree_reuses_its_dropped_nodes_slots() {
         let mut space = SearchSpace::<8>::new();
-        let SearchSpace {
-            nodes: [nodes, _],
-            parents: [parents, _],
-            edges: [edges, _],
-            moved_to: [moved_to, _],
-            len: [len, _],
-            added: [added, _],
-        } = &mut space;
-        let mut tree = Tree {
-            nodes,
-            parents,
-            edges,
-            moved_to,
-            len,
-            added,
-            capacity: 8,
-            limit: 11,
-        };
+        let [mut tree, _] = space.trees(8, 11);
         tree.plant(&mark(0.0));
         // 0 ─ 1 ─ 2 ─ 4 ─ 6, and 1 ─ 3 ─ 5 ─ 7: dropping 3 drops 5 and 7.
         for (i, parent) in [0, 1, 1, 2, 3, 4, 5].into_iter().enumerate() {
