@@ -58,34 +58,57 @@ pub const fn nodes_for(pieces: usize) -> usize {
 }
 
 /// A piece as the build sorts it: its centroid and the number its caller gave it. The build
-/// moves these 16-byte keys instead of the pieces, which are then put in place once.
+/// moves these 16-byte keys instead of the pieces, which are then put in place once. Held as
+/// four words (x, y and z as `f32` bits, then the number), so that a key moves as one 16-byte
+/// value and [`partition`] can pick between two keys without a branch.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(16))]
 pub struct Key {
-    centroid: [f32; 3],
-    piece: u32,
+    bits: [u32; 4],
 }
 
 impl Key {
     /// Fills key buffers before [`build`] writes them.
-    pub const EMPTY: Self = Self {
-        centroid: [0.0; 3],
-        piece: 0,
-    };
+    pub const EMPTY: Self = Self { bits: [0; 4] };
 
     /// The key of piece number `piece`, whose centroid (finite) is `centroid`.
     pub const fn new(centroid: [f32; 3], piece: u32) -> Self {
-        Self { centroid, piece }
+        Self {
+            bits: [
+                centroid[0].to_bits(),
+                centroid[1].to_bits(),
+                centroid[2].to_bits(),
+                piece,
+            ],
+        }
     }
 
     /// The number the piece was given.
     pub const fn piece(&self) -> u32 {
-        self.piece
+        self.bits[3]
     }
 
     /// The piece's centroid as the key was made with it (a cloud's point itself: the caller
     /// can make the ball from the key, without reading the point again).
     pub const fn centroid(&self) -> [f32; 3] {
-        self.centroid
+        [
+            f32::from_bits(self.bits[0]),
+            f32::from_bits(self.bits[1]),
+            f32::from_bits(self.bits[2]),
+        ]
+    }
+
+    /// The centroid's coordinate on `axis` (0, 1 or 2).
+    fn coordinate(&self, axis: usize) -> f32 {
+        f32::from_bits(self.bits.get(axis).copied().unwrap_or(0))
+    }
+
+    /// `a` if `take_a`, else `b`, word by word through a mask: no branch on a coin toss.
+    fn pick(take_a: bool, a: Self, b: Self) -> Self {
+        let mask = 0u32.wrapping_sub(u32::from(take_a));
+        Self {
+            bits: core::array::from_fn(|k| (a.bits[k] & mask) | (b.bits[k] & !mask)),
+        }
     }
 }
 
@@ -94,8 +117,9 @@ impl Key {
 fn centroid_box(keys: &[Key]) -> ([f32; 3], [f32; 3]) {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for key in keys {
+        let centroid = key.centroid();
         for k in 0..3 {
-            let c = key.centroid[k];
+            let c = centroid[k];
             lo[k] = if c < lo[k] { c } else { lo[k] };
             hi[k] = if c > hi[k] { c } else { hi[k] };
         }
@@ -108,9 +132,25 @@ fn centroid_box(keys: &[Key]) -> ([f32; 3], [f32; 3]) {
 /// the side): on a cloud the side is a coin toss, and a mispredicted branch per key would cost
 /// more than the pass.
 fn partition(keys: &mut [Key], axis: usize, middle: f32) -> usize {
+    // The axis a constant in each loop: a coordinate picked at run time was read through
+    // memory.
+    match axis {
+        0 => partition_on::<0>(keys, middle),
+        1 => partition_on::<1>(keys, middle),
+        _ => partition_on::<2>(keys, middle),
+    }
+}
+
+/// [`partition`] on axis `AXIS`. The key at `front` is carried in a register (`first`): read
+/// back from the slot the last step wrote, it would wait on that store whenever the last key
+/// went to the back.
+fn partition_on<const AXIS: usize>(keys: &mut [Key], middle: f32) -> usize {
+    let Some(&(mut first)) = keys.first() else {
+        return 0;
+    };
     let mut front = 0;
     for i in 0..keys.len() {
-        let (Some(&key), Some(&first)) = (keys.get(i), keys.get(front)) else {
+        let Some(&key) = keys.get(i) else {
             break;
         };
         if let Some(slot) = keys.get_mut(i) {
@@ -119,7 +159,12 @@ fn partition(keys: &mut [Key], axis: usize, middle: f32) -> usize {
         if let Some(slot) = keys.get_mut(front) {
             *slot = key;
         }
-        front += usize::from(key.centroid[axis] < middle);
+        let to_front = f32::from_bits(key.bits[AXIS]) < middle;
+        // The key at `front` next: the one after it when this key went to the front (read
+        // either way), else this key.
+        let after = keys.get(front + 1).copied().unwrap_or(key);
+        front += usize::from(to_front);
+        first = Key::pick(to_front, after, key);
     }
     front
 }
@@ -258,7 +303,7 @@ fn divide(run: &mut [Key]) -> usize {
     let least = (count / 8).max(LEAF / 2);
     if mid < least || mid > count - least {
         mid = count / 2;
-        run.select_nth_unstable_by(mid, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
+        run.select_nth_unstable_by(mid, |a, b| a.coordinate(axis).total_cmp(&b.coordinate(axis)));
     }
     mid
 }
@@ -381,7 +426,7 @@ pub fn build(
     }
     let used = split(keys, nodes)?;
     for (slot, key) in pieces.iter_mut().zip(keys.iter()) {
-        if let Some(e) = input.get(key.piece as usize) {
+        if let Some(e) = input.get(key.piece() as usize) {
             *slot = *e;
         }
     }
@@ -467,6 +512,52 @@ mod tests {
             assert_eq!(serial[..used], threaded[..used], "{n} keys");
             assert!(serial[0].lo[0] < serial[0].hi[0]);
         }
+    }
+
+    #[test]
+    fn partition_leaves_the_keys_as_the_plain_swapping_pass_does() {
+        // The pass as first written: every key swapped with the one at `front`, read back from
+        // the buffer. The carried key must leave every key where that pass leaves it.
+        fn swapping(keys: &mut [Key], axis: usize, middle: f32) -> usize {
+            let mut front = 0;
+            for i in 0..keys.len() {
+                keys.swap(i, front);
+                front += usize::from(keys[front].centroid()[axis] < middle);
+            }
+            front
+        }
+        let mut rng = crate::rng::Rng::new(3);
+        for n in [0usize, 1, 2, 17, 1000] {
+            let keys: Vec<Key> = (0..n)
+                .map(|i| {
+                    // A coarse grid: equal coordinates, runs of one side, -0.0 beside 0.0.
+                    let c = core::array::from_fn(|_| (rng.uniform_f32(-3.0, 3.0) as i32) as f32 * 0.5);
+                    let c = if i % 7 == 0 { [-0.0, c[1], c[2]] } else { c };
+                    Key::new(c, i as u32)
+                })
+                .collect();
+            for axis in 0..3 {
+                for middle in [-1.0f32, 0.0, 0.25, 5.0] {
+                    let (mut ours, mut theirs) = (keys.clone(), keys.clone());
+                    let front = partition(&mut ours, axis, middle);
+                    assert_eq!(front, swapping(&mut theirs, axis, middle), "{n} keys, axis {axis}");
+                    assert_eq!(ours, theirs, "{n} keys, axis {axis}, middle {middle}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_key_gives_back_its_centroid_and_piece_bit_for_bit() {
+        let key = Key::new([-0.0, 1.5e-39, -7.25], u32::MAX);
+        assert_eq!(
+            key.centroid().map(f32::to_bits),
+            [(-0.0f32).to_bits(), 1.5e-39f32.to_bits(), (-7.25f32).to_bits()]
+        );
+        assert_eq!((key.piece(), key.coordinate(2)), (u32::MAX, -7.25));
+        let other = Key::new([1.0; 3], 4);
+        assert_eq!(Key::pick(true, key, other), key);
+        assert_eq!(Key::pick(false, key, other), other);
     }
 
     #[test]
