@@ -60,7 +60,7 @@ pub const fn nodes_for(pieces: usize) -> usize {
 /// A piece as the build sorts it: its centroid and the number its caller gave it. The build
 /// moves these 16-byte keys instead of the pieces, which are then put in place once. Held as
 /// four words (x, y and z as `f32` bits, then the number), so that a key moves as one 16-byte
-/// value and [`partition`] can pick between two keys without a branch.
+/// value and the splits' partition can pick between two keys without a branch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(16))]
 pub struct Key {
