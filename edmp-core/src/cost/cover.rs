@@ -7,6 +7,7 @@ use crate::collision::convex::Convex;
 use crate::scene::Obstacle;
 use crate::surface::Surface;
 use crate::surface::bvh::{MAX_DEPTH, Node};
+use crate::surface::element::Piece;
 use nalgebra::Vector3;
 
 /// The most boxes one surface gets.
@@ -99,11 +100,18 @@ fn fitted(surface: &Surface<'_>, node: &Node) -> Option<Obstacle> {
 fn reach(surface: &Surface<'_>, node: &Node, a: &Vector3<f32>) -> f32 {
     let (nodes, pieces) = (surface.nodes(), surface.pieces());
     let mut best = f32::NEG_INFINITY;
+    // A ball's support is `center + a · (radius / |a|)` (`Element::support`): the same
+    // operations with `|a|` found once, not once a ball (a wall along `a` ties at every leaf,
+    // so every one of its balls is read).
+    let norm = crate::float::sqrt(a.norm_squared());
     let over = |run: &Node, best: f32| {
         let end = run.first as usize + run.count as usize;
         let run = pieces.get(run.first as usize..end).unwrap_or(&[]);
         run.iter().fold(best, |best, e| {
-            let v = e.support(a).dot(a);
+            let v = match &e.piece {
+                Piece::Ball { center, radius } if norm > 0.0 => (center + a * (radius / norm)).dot(a),
+                _ => e.support(a).dot(a),
+            };
             if v > best { v } else { best }
         })
     };
@@ -187,5 +195,56 @@ mod tests {
         }
         let mut many = [out[0]; 8];
         assert_eq!(covers(&surface, &mut many), 8);
+    }
+
+    #[test]
+    fn reach_is_the_largest_support_a_pass_over_every_piece_finds() {
+        // Walls along the axes (every leaf ties along their normal), balls of two radii, a few
+        // triangles, and directions of any length (zero included).
+        let mut rng = crate::rng::Rng::new(11);
+        let mut pieces: Vec<Element> = (0..3000)
+            .map(|i| {
+                let (u, v) = ((i % 50) as f32 * 0.01, ((i / 50) % 60) as f32 * 0.01);
+                let c = match i % 3 {
+                    0 => [0.5, u, v],
+                    1 => [u, -0.2, v],
+                    _ => [u, v, 0.1],
+                };
+                Element::ball(c, if i % 7 == 0 { 0.01 } else { 0.0075 }, 0).unwrap()
+            })
+            .collect();
+        for _ in 0..40 {
+            let corner = |rng: &mut crate::rng::Rng| [0; 3].map(|_| rng.uniform_f32(-0.3, 0.8));
+            let t = [corner(&mut rng), corner(&mut rng), corner(&mut rng)];
+            if let Ok(Some(e)) = Element::triangle(t, 1) {
+                pieces.push(e);
+            }
+        }
+        let n = pieces.len();
+        let mut nodes = std::vec![Node::EMPTY; nodes_for(n)];
+        let mut keys = std::vec![Key::EMPTY; n];
+        let used = build(&pieces.clone(), &mut pieces, &mut nodes, &mut keys).unwrap();
+        let surface = Surface::new(&pieces, &nodes[..used]).unwrap();
+        let mut directions: Vec<Vector3<f32>> = (0..200)
+            .map(|_| Vector3::from([0; 3].map(|_| rng.uniform_f32(-2.0, 2.0))))
+            .collect();
+        directions.extend([Vector3::x(), -Vector3::y(), Vector3::z() * 3.0, Vector3::zeros()]);
+        for a in &directions {
+            let every = pieces.iter().fold(f32::NEG_INFINITY, |best, e| {
+                let v = e.support(a).dot(a);
+                if v > best { v } else { best }
+            });
+            for node in &nodes[..used] {
+                let end = (node.first + node.count) as usize;
+                let under = pieces[node.first as usize..end]
+                    .iter()
+                    .fold(f32::NEG_INFINITY, |best, e| {
+                        let v = e.support(a).dot(a);
+                        if v > best { v } else { best }
+                    });
+                assert_eq!(reach(&surface, node, a).to_bits(), under.to_bits(), "{a:?}");
+            }
+            assert_eq!(reach(&surface, &nodes[0], a).to_bits(), every.to_bits(), "{a:?}");
+        }
     }
 }

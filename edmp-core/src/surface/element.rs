@@ -54,6 +54,7 @@ impl Aabb {
     };
 
     /// The smallest box holding both.
+    #[inline]
     pub fn union(&self, other: &Self) -> Self {
         Self {
             lo: self.lo.zip_map(&other.lo, f32::min),
@@ -62,6 +63,7 @@ impl Aabb {
     }
 
     /// Squared distance from `p` to the box (0 inside).
+    #[inline]
     pub fn distance_squared(&self, p: &Vector3<f32>) -> f32 {
         let mut d2 = 0.0;
         for k in 0..3 {
@@ -74,6 +76,7 @@ impl Aabb {
     }
 
     /// Squared distance between the two boxes (0 when they overlap).
+    #[inline]
     pub fn distance_squared_to(&self, other: &Self) -> f32 {
         let mut d2 = 0.0;
         for k in 0..3 {
@@ -84,6 +87,7 @@ impl Aabb {
     }
 
     /// The box around a ball.
+    #[inline]
     pub fn around_ball(center: &Vector3<f32>, radius: f32) -> Self {
         Self {
             lo: center.add_scalar(-radius),
@@ -183,6 +187,7 @@ impl Element {
     }
 
     /// The smallest axis-aligned box holding the piece.
+    #[inline]
     pub fn bounds(&self) -> Aabb {
         match &self.piece {
             Piece::Ball { center, radius } => Aabb {
