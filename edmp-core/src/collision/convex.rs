@@ -257,12 +257,18 @@ impl Convex for Solid {
     }
 }
 
-impl Convex for Element {
-    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
+impl Element {
+    /// [`Convex::support`] along `d` with `norm` = `|d|` (what a ball needs) found by the
+    /// caller: one that asks many pieces along the same `d` finds it once.
+    #[inline]
+    pub(crate) fn support_with_norm(&self, d: &Vector3<f32>, norm: f32) -> Vector3<f32> {
         match &self.piece {
             Piece::Ball { center, radius } => {
-                let n = crate::float::sqrt(d.norm_squared());
-                if n > 0.0 { center + d * (radius / n) } else { *center }
+                if norm > 0.0 {
+                    center + d * (radius / norm)
+                } else {
+                    *center
+                }
             }
             Piece::Triangle { corners } => {
                 let mut best = corners[0];
@@ -277,6 +283,17 @@ impl Convex for Element {
                 best
             }
         }
+    }
+}
+
+impl Convex for Element {
+    fn support(&self, d: &Vector3<f32>) -> Vector3<f32> {
+        // Only a ball needs `|d|`.
+        let norm = match self.piece {
+            Piece::Ball { .. } => crate::float::sqrt(d.norm_squared()),
+            Piece::Triangle { .. } => 0.0,
+        };
+        self.support_with_norm(d, norm)
     }
 }
 

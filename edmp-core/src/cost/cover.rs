@@ -3,11 +3,9 @@
 //! around one subtree of the hierarchy, turned about z to fit its pieces (the walls of a
 //! shelf stand at any yaw). The guides only steer: the checker still judges the exact pieces.
 
-use crate::collision::convex::Convex;
 use crate::scene::Obstacle;
 use crate::surface::Surface;
 use crate::surface::bvh::{MAX_DEPTH, Node};
-use crate::surface::element::Piece;
 use nalgebra::Vector3;
 
 /// The most boxes one surface gets.
@@ -100,18 +98,14 @@ fn fitted(surface: &Surface<'_>, node: &Node) -> Option<Obstacle> {
 fn reach(surface: &Surface<'_>, node: &Node, a: &Vector3<f32>) -> f32 {
     let (nodes, pieces) = (surface.nodes(), surface.pieces());
     let mut best = f32::NEG_INFINITY;
-    // A ball's support is `center + a · (radius / |a|)` (`Element::support`): the same
-    // operations with `|a|` found once, not once a ball (a wall along `a` ties at every leaf,
-    // so every one of its balls is read).
+    // `|a|` found once, not once a ball: a wall along `a` ties at every leaf, so every one of
+    // its balls is read.
     let norm = crate::float::sqrt(a.norm_squared());
     let over = |run: &Node, best: f32| {
         let end = run.first as usize + run.count as usize;
         let run = pieces.get(run.first as usize..end).unwrap_or(&[]);
         run.iter().fold(best, |best, e| {
-            let v = match &e.piece {
-                Piece::Ball { center, radius } if norm > 0.0 => (center + a * (radius / norm)).dot(a),
-                _ => e.support(a).dot(a),
-            };
+            let v = e.support_with_norm(a, norm).dot(a);
             if v > best { v } else { best }
         })
     };
@@ -158,7 +152,7 @@ fn box_reach(n: &Node, a: &Vector3<f32>) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::collision::convex::Solid;
+    use crate::collision::convex::{Convex, Solid};
     use crate::surface::bvh::{Key, build, nodes_for};
     use crate::surface::element::Element;
     use std::vec::Vec;

@@ -186,9 +186,7 @@ impl<const CAP: usize, const J: usize> SearchSpace<CAP, J> {
             added: [0; 2],
         }
     }
-}
 
-impl<const CAP: usize, const J: usize> SearchSpace<CAP, J> {
     /// The start tree and the goal tree, borrowed for growing, each holding at most `capacity`
     /// nodes at once and adding at most `limit` in all.
     fn trees(&mut self, capacity: usize, limit: usize) -> [Tree<'_, CAP, J>; 2] {
